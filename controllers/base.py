@@ -1,0 +1,39 @@
+"""The robot interface: an :class:`Observation` in, a :class:`Command` out.
+
+A controller never touches MuJoCo. The world samples sensors at the control period and hands each robot an
+observation; the robot's controller returns a command in the common locomotion form (v, omega) plus whatever
+extras its robot has (gripper, ...), the message it wants to broadcast, and the name of its current behaviour
+(shown in videos and timelines, and timed per robot).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any, Protocol
+
+import numpy as np
+
+
+@dataclass(frozen=True)
+class Observation:
+    time: float
+    robot: str
+    ir_raw: np.ndarray  # raw IR readings (0 = nothing)
+    ir_range: np.ndarray  # range estimates from the robot's own calibration, m (inf = nothing)
+    ir_bearings: np.ndarray  # body-frame bearing of each IR sensor, rad
+    pose: Any  # latest positioning fix (teamsim.positioning.PoseFix) or None before the first
+    inbox: tuple = ()  # radio messages received since the last tick
+    robots_present: frozenset = frozenset()
+    wheel_speeds: np.ndarray = field(default_factory=lambda: np.zeros(0))  # encoders, rad/s
+
+
+@dataclass(frozen=True)
+class Command:
+    v: float = 0.0  # forward speed, m/s
+    omega: float = 0.0  # turn rate, rad/s (counter-clockwise positive)
+    behaviour: str = "idle"
+    broadcast: Any = None  # payload for the next radio slot; None keeps the previous one
+    extras: dict = field(default_factory=dict)  # robot-specific actuators, e.g. {"gripper": "close"}
+
+
+class Controller(Protocol):
+    def __call__(self, observation: Observation) -> Command: ...

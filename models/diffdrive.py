@@ -1,0 +1,84 @@
+"""``diffdrive``: Chand's circular differential-drive robot (Robot B of Table 3.1; MARVIN base, Table 5.22).
+
+Thesis values: enclosing radius 0.35 m (ch.3) or 0.40 m (ch.5), v <= 0.5 m/s, omega <= pi/7 rad/s, ten 1.5 m IR
+sensors evenly over 360 degrees. Everything else (mass, height, wheels, casters, motor torque, acceleration) is
+not in the thesis and is assumed below, in one place.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from dm_control import mjcf
+
+from teamsim.models.ir import IRModel
+from teamsim.models.robot import DriveLimits, RobotModel, add_ir_ring, add_tracking_camera, colour_of
+
+
+@dataclass(frozen=True)
+class DiffDriveDims:
+    radius: float = 0.35  # Table 3.1 (0.40 in ch.5, Table 5.22)
+    ir_count: int = 10  # Table 3.1
+    ir_range: float = 1.5  # Table 3.1
+    v_max: float = 0.5  # Table 3.1
+    omega_max: float = math.pi / 7  # Table 3.1
+    # Chand gives acceleration limits only for Scratchy (Table 3.4); we apply them to this robot too.
+    accel_max: float = 0.1
+    angular_accel_max: float = 0.15
+    # Assumed (not in the thesis):
+    height: float = 0.35
+    mass: float = 12.0
+    ground_clearance: float = 0.04
+    wheel_radius: float = 0.08
+    wheel_width: float = 0.03
+    wheel_inset: float = 0.08  # wheel centre inside the rim, so wheels sit in body slots
+    wheel_torque: float = 6.0  # N m per wheel motor
+    caster_radius: float = 0.03
+    caster_gap: float = 0.004  # casters ride this far above the floor so the wheels carry the load
+    battery_mass: float = 3.0  # kg, ahead of the axle: the robot leans on its front caster, not its back one
+    battery_x: float = 0.1
+    ir_height: float = 0.2
+
+    @property
+    def track_width(self) -> float:
+        return 2 * (self.radius - self.wheel_inset)
+
+
+def build(name: str, dims: DiffDriveDims = DiffDriveDims()) -> RobotModel:
+    model = mjcf.RootElement(model=name)
+    rgba = colour_of(name)
+    chassis = model.worldbody.add("body", name="chassis")
+    body_half = (dims.height - dims.ground_clearance) / 2
+    chassis.add("geom", name="shell", type="cylinder", size=[dims.radius, body_half],
+                pos=[0, 0, dims.ground_clearance + body_half], mass=dims.mass, rgba=[0.35, 0.35, 0.38, 1])
+    chassis.add("geom", name="lid", type="cylinder", size=[dims.radius * 0.9, 0.005],
+                pos=[0, 0, dims.height + 0.005], rgba=rgba, contype=0, conaffinity=0, mass=0.01)
+    chassis.add("geom", name="nose", type="box", size=[dims.radius * 0.2, 0.04, 0.006],
+                pos=[dims.radius * 0.7, 0, dims.height + 0.012], rgba=[1, 1, 1, 1],
+                contype=0, conaffinity=0, mass=0.01)
+    chassis.add("geom", name="battery", type="box", size=[0.06, 0.1, 0.05], mass=dims.battery_mass,
+                pos=[dims.battery_x, 0, dims.ground_clearance + 0.06], contype=0, conaffinity=0, group=3)
+    # Frictionless ball casters fore and aft: a caster with lateral friction stops a diff-drive turning
+    # (maxspahn/gym_envs_urdf#140), so they carry normal load only (condim 1). They sit a few mm high: four
+    # rigid supports share the weight arbitrarily, and wheels left with little load slip.
+    for side, x in (("front", 1), ("back", -1)):
+        chassis.add("geom", name=f"caster_{side}", type="sphere", size=[dims.caster_radius],
+                    pos=[x * (dims.radius - 0.08), 0, dims.caster_radius + dims.caster_gap], condim=1, mass=0.1,
+                    rgba=[0.2, 0.2, 0.2, 1])
+    motors = []
+    for side, y in (("left", 1), ("right", -1)):
+        wheel = chassis.add("body", name=f"{side}_wheel", pos=[0, y * dims.track_width / 2, dims.wheel_radius])
+        wheel.add("joint", name=side, type="hinge", axis=[0, 1, 0], damping=0.05)
+        wheel.add("geom", name=f"{side}_tyre", type="cylinder", size=[dims.wheel_radius, dims.wheel_width / 2],
+                  zaxis=[0, 1, 0], mass=0.5, friction=[1.2, 0.01, 0.001], rgba=[0.1, 0.1, 0.1, 1])
+        model.actuator.add("velocity", name=side, joint=side, kv=dims.wheel_torque,
+                           forcerange=[-dims.wheel_torque, dims.wheel_torque], forcelimited=True,
+                           ctrlrange=[-dims.v_max / dims.wheel_radius * 1.5, dims.v_max / dims.wheel_radius * 1.5])
+        motors.append(side)
+    ir_names, bearings = add_ir_ring(chassis, dims.ir_count, dims.radius + 0.005, dims.ir_height, dims.ir_range)
+    camera = add_tracking_camera(chassis, distance=2.0)
+    limits = DriveLimits(dims.v_max, dims.omega_max, dims.accel_max, dims.angular_accel_max)
+    return RobotModel(kind="diffdrive", name=name, mjcf=model, root_body="chassis", ir_sensors=ir_names,
+                      ir_bearings=bearings, ir=IRModel.for_range(dims.ir_range), motors=tuple(motors),
+                      wheel_radius=dims.wheel_radius, track_width=dims.track_width, limits=limits,
+                      footprint_radius=dims.radius, tracking_camera=camera)

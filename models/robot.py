@@ -1,0 +1,88 @@
+"""What a robot *is*: its MJCF, and the names of the bodies, sensors and actuators the world drives.
+
+Every robot kind builds a :class:`RobotModel`. Names are local to the robot's MJCF; once attached to an arena
+they are prefixed with the robot's name (``red/left``), which is the robot's MJCF model name.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from dm_control import mjcf
+
+from teamsim.models.ir import IRModel
+
+# Colours for the first robots, in Parker's naming style (RED, GREEN, BLUE...). Later robots get r<N>.
+TEAM_COLOURS: dict[str, tuple[float, float, float, float]] = {
+    "red": (0.85, 0.15, 0.15, 1), "green": (0.15, 0.7, 0.2, 1), "blue": (0.15, 0.35, 0.9, 1),
+    "yellow": (0.95, 0.85, 0.1, 1), "cyan": (0.1, 0.8, 0.85, 1), "magenta": (0.85, 0.2, 0.8, 1),
+    "orange": (1.0, 0.55, 0.1, 1), "purple": (0.5, 0.25, 0.75, 1), "white": (0.95, 0.95, 0.95, 1),
+    "black": (0.15, 0.15, 0.15, 1),
+}
+
+
+def team_names(count: int) -> list[str]:
+    colours = list(TEAM_COLOURS)
+    return [colours[i] if i < len(colours) else f"r{i}" for i in range(count)]
+
+
+def colour_of(name: str) -> tuple[float, float, float, float]:
+    if name in TEAM_COLOURS:
+        return TEAM_COLOURS[name]
+    hue = (hash_name(name) % 360) / 360.0  # stable pseudo-random hue for unnamed colours
+    r, g, b = (0.5 + 0.4 * math.cos(2 * math.pi * (hue + k / 3)) for k in range(3))
+    return (r, g, b, 1.0)
+
+
+def hash_name(name: str) -> int:
+    return sum((i + 1) * ord(c) for i, c in enumerate(name))
+
+
+@dataclass(frozen=True)
+class DriveLimits:
+    """Limits of the common (v, omega) locomotion command."""
+    v_max: float  # m/s
+    omega_max: float  # rad/s
+    accel_max: float  # m/s^2
+    angular_accel_max: float  # rad/s^2
+
+
+@dataclass(frozen=True)
+class RobotModel:
+    kind: str
+    name: str
+    mjcf: mjcf.RootElement
+    root_body: str
+    ir_sensors: tuple[str, ...]
+    ir_bearings: np.ndarray  # bearing of each IR sensor in the body frame, rad, same order as ir_sensors
+    ir: IRModel
+    motors: tuple[str, ...]  # locomotion actuators, in the order the locomotion controller fills them
+    wheel_radius: float
+    track_width: float
+    limits: DriveLimits
+    footprint_radius: float
+    tracking_camera: str
+
+
+def add_ir_ring(body: mjcf.Element, count: int, radius: float, height: float, max_range: float,
+                first_bearing: float = 0.0) -> tuple[tuple[str, ...], np.ndarray]:
+    """Rangefinder sites evenly spaced over 360 degrees, looking outward from ``radius`` at ``height``."""
+    root = body.root
+    names, bearings = [], []
+    for k in range(count):
+        bearing = first_bearing + 2 * math.pi * k / count
+        c, s = math.cos(bearing), math.sin(bearing)
+        site = body.add("site", name=f"ir{k}", pos=[radius * c, radius * s, height], size=[0.01],
+                        zaxis=[c, s, 0], rgba=[1, 0.3, 0.3, 0.6], group=3)
+        root.sensor.add("rangefinder", name=f"ir{k}", site=site, cutoff=max_range)
+        names.append(f"ir{k}")
+        bearings.append(bearing)
+    return tuple(names), np.asarray(bearings)
+
+
+def add_tracking_camera(body: mjcf.Element, distance: float) -> str:
+    """A camera that follows the body from behind and above, in the world frame (mode=track)."""
+    body.add("camera", name="track", mode="track", pos=[0, -distance, distance],
+             xyaxes=[1, 0, 0, 0, 0.7071, 0.7071], fovy=60)
+    return "track"

@@ -1,0 +1,50 @@
+"""What a mission is: it sets up the world (arena and team), gives each robot a controller, says when the
+trial is over and whether it succeeded, and measures it.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any, ClassVar, Protocol
+
+import numpy as np
+from dm_control import mjcf
+
+from teamsim.controllers.base import Controller
+from teamsim.models.robot import RobotModel
+
+
+@dataclass(frozen=True)
+class RobotSlot:
+    """One robot of the team: who, what kind, where it starts, and whether it waits for an add-robot fault."""
+    name: str
+    kind: str
+    x: float
+    y: float
+    yaw: float
+    dormant: bool = False
+
+
+@dataclass
+class Scene:
+    arena: mjcf.RootElement
+    robots: list[RobotSlot]
+
+
+class Mission(Protocol):
+    name: ClassVar[str]
+    summary: ClassVar[str]
+    Params: ClassVar[type]
+    default_duration: ClassVar[float]
+
+    def build(self, params: Any, rng: np.random.Generator, newcomers: list[tuple[str, str]],
+              physics_dt: float) -> Scene:
+        """The arena and the team; ``newcomers`` are (name, kind) pairs that join later (add-robot faults)."""
+
+    def controller(self, robot: RobotModel, params: Any, rng: np.random.Generator) -> Controller:
+        """The controller that drives ``robot``."""
+
+    def done(self, world: Any) -> bool:
+        """True when the mission has ended before its time limit."""
+
+    def outcome(self, world: Any) -> tuple[bool, dict]:
+        """(completed, metrics) measured from the world at the end of the trial."""

@@ -1,0 +1,79 @@
+"""``wander``: the smoke mission. N differential-drive robots wander with IR obstacle avoidance in a walled
+room for a fixed time. It completes when the time runs out with the physics stable; it measures how far each
+robot went and how much of the time robots spent touching walls, obstacles or each other.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from teamsim.config import ConfigError, setting
+from teamsim.controllers.wander import WanderController
+from teamsim.models.arenas import Box, walled_room
+from teamsim.models.robot import RobotModel, team_names
+from teamsim.tasks.base import RobotSlot, Scene
+
+CELL = 1.2  # m; spawn grid pitch, wide enough for a 0.35 m robot plus clearance
+
+
+@dataclass
+class WanderParams:
+    robots: int = setting(3, lo=1, hi=200, meaning="number of diffdrive robots")
+    room_size: float = setting(0.0, lo=0.0, hi=200.0,
+                               meaning="side of the square room, m (0: sized for the team, 3 m^2 per robot, >= 6 m)")
+    obstacles: int = setting(3, lo=0, hi=100, meaning="static box obstacles placed at random")
+    kind: str = setting("diffdrive", choices=("diffdrive",), meaning="robot kind of the team")
+
+    def side(self, team_size: int) -> float:
+        return self.room_size or max(6.0, math.sqrt(3.0 * team_size))
+
+    def check(self) -> None:
+        side = self.side(self.robots)
+        cells = int(side / CELL) ** 2
+        if self.robots + self.obstacles > cells:
+            raise ConfigError(f"robots={self.robots}, obstacles={self.obstacles}: a {side:g} m room has room for "
+                              f"{cells} robots and obstacles together; raise room_size")
+
+
+class WanderMission:
+    name = "wander"
+    summary = "N differential-drive robots wander with IR obstacle avoidance in a walled room"
+    Params = WanderParams
+    default_duration = 60.0
+
+    def build(self, params: WanderParams, rng: np.random.Generator, newcomers: list[tuple[str, str]],
+              physics_dt: float) -> Scene:
+        team = [(name, params.kind) for name in team_names(params.robots)]
+        side = params.side(len(team) + len(newcomers))
+        per_row = int(side / CELL)
+        offset = -side / 2 + (side - per_row * CELL) / 2 + CELL / 2
+        cells = [(offset + i * CELL, offset + j * CELL) for i in range(per_row) for j in range(per_row)]
+        needed = len(team) + len(newcomers) + params.obstacles
+        if needed > len(cells):
+            raise ConfigError(f"wander: {needed} robots and obstacles do not fit a {side:g} m room; raise room_size")
+        order = rng.permutation(len(cells))[:needed]
+        chosen = [cells[k] for k in order]
+        obstacles = tuple(Box(x, y, *rng.uniform(0.15, 0.45, size=2), yaw=float(rng.uniform(0, math.pi)))
+                          for x, y in chosen[:params.obstacles])
+        slots = [RobotSlot(name, kind, x, y, float(rng.uniform(-math.pi, math.pi)), dormant=k >= len(team))
+                 for k, ((name, kind), (x, y)) in enumerate(zip(team + newcomers, chosen[params.obstacles:]))]
+        arena = walled_room(side, side, obstacles=obstacles, physics_dt=physics_dt)
+        return Scene(arena=arena, robots=slots)
+
+    def controller(self, robot: RobotModel, params: WanderParams, rng: np.random.Generator):
+        return WanderController(robot.ir_bearings, rng)
+
+    def done(self, world) -> bool:
+        return False
+
+    def outcome(self, world) -> tuple[bool, dict]:
+        distance = world.odometry()
+        touching = world.contact_fraction()
+        metrics = {
+            "distance_m": distance,
+            "mean_distance_m": float(np.mean(list(distance.values()))) if distance else 0.0,
+            "touching_fraction": touching,
+        }
+        return True, metrics

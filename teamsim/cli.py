@@ -1,0 +1,146 @@
+"""``teamsim``: run missions headless, render videos, export robots, benchmark.
+
+Every bad input ends in one line, ``teamsim: error: ...``, and exit status 2.
+"""
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+from teamsim.config import ConfigError, TrialConfig, apply_setting, validate
+from teamsim.faults import FAULT_KINDS, SPEC_FORM, parse_fault
+from teamsim.gl import RenderBackendError
+
+EXIT_USAGE = 2
+
+
+class UsageError(Exception):
+    pass
+
+
+class _Parser(argparse.ArgumentParser):
+    def error(self, message: str):  # one line, not argparse's usage block
+        raise UsageError(message)
+
+
+def _build_parser() -> argparse.ArgumentParser:
+    parser = _Parser(prog="teamsim", description=__doc__.splitlines()[0])
+    commands = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
+    commands.add_parser("list", help="robots, missions and studies")
+
+    run = commands.add_parser("run", help="run one trial of a mission")
+    run.add_argument("mission")
+    run.add_argument("--seed", type=int, default=0)
+    run.add_argument("--duration", type=float, help="simulated seconds (default: the mission's)")
+    run.add_argument("--video", action="store_true", help="write video.mp4 (H.264)")
+    run.add_argument("--camera", default="top", help="'top' or a robot name for its tracking camera")
+    run.add_argument("--out", default="renders", help="output root (default: renders)")
+    run.add_argument("--run-id", help="run folder name (default: seed and timestamp)")
+    run.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
+                     help="mission parameter (robots=5) or group.key (radio.loss=0.2)")
+    run.add_argument("--fault", action="append", default=[], metavar="SPEC",
+                     help=f"{SPEC_FORM}; kinds: {', '.join(FAULT_KINDS)}")
+
+    render = commands.add_parser("render", help="re-render a run's video from its trajectory.npz")
+    render.add_argument("run_dir", type=Path)
+    render.add_argument("--camera", default="top")
+    render.add_argument("--out", type=Path, help="video path (default: RUN_DIR/video-CAMERA.mp4)")
+    render.add_argument("--width", type=int, default=640)
+    render.add_argument("--height", type=int, default=480)
+
+    export = commands.add_parser("export", help="standalone MJCF of one robot on a floor")
+    export.add_argument("robot")
+    export.add_argument("--out", type=Path, required=True)
+
+    bench = commands.add_parser("bench", help="benchmarks")
+    bench.add_argument("what", choices=("physics", "render"))
+    bench.add_argument("--seconds", type=float, default=None, help="simulated seconds per measurement")
+    return parser
+
+
+def _trial_config(args) -> TrialConfig:
+    from teamsim.runner import mission_of
+
+    mission = mission_of(args.mission)
+    config = TrialConfig(mission=args.mission, params=mission.Params(), seed=args.seed, duration=args.duration,
+                         out=args.out, run_id=args.run_id)
+    config.video.enabled = args.video
+    config.video.camera = args.camera
+    for assignment in args.set:
+        apply_setting(config, assignment)
+    config.faults = [parse_fault(spec) for spec in args.fault]
+    validate(config)
+    return config
+
+
+def cmd_run(args) -> int:
+    from teamsim.runner import run_trial
+
+    result = run_trial(_trial_config(args))
+    s = result.summary
+    print(f"{s['status']}: {result.run_dir} ({s['sim_time_s']:.1f} s simulated in {s['wall_time_s']:.1f} s, "
+          f"{s['real_time_factor']}x real time)")
+    if s.get("error"):
+        print(f"  {s['error']}", file=sys.stderr)
+    return {"completed": 0, "interrupted": 130}.get(result.status, 1)
+
+
+def cmd_list(_args) -> int:
+    from teamsim.models import ROBOT_BUILDERS, ROBOT_KINDS, build_robot
+    from teamsim.tasks import MISSIONS
+
+    print("robots:")
+    for kind in ROBOT_KINDS:
+        if kind in ROBOT_BUILDERS:
+            robot = build_robot(kind, "x")
+            print(f"  {kind:<10} {len(robot.ir_sensors)} IR ({robot.ir.max_range:g} m), "
+                  f"actuators: {', '.join(robot.motors)}; v<={robot.limits.v_max:g} m/s")
+        else:
+            print(f"  {kind:<10} (not built yet)")
+    print("missions:")
+    for name, mission in MISSIONS.items():
+        print(f"  {name:<10} {mission.summary}")
+    print("studies:\n  (none yet)")
+    return 0
+
+
+def cmd_render(args) -> int:
+    from teamsim.rerender import rerender
+
+    out = rerender(args.run_dir, args.camera, args.out, args.width, args.height)
+    print(f"wrote {out}")
+    return 0
+
+
+def cmd_export(args) -> int:
+    from teamsim.export import export_robot
+
+    export_robot(args.robot, args.out)
+    print(f"wrote {args.out}")
+    return 0
+
+
+def cmd_bench(args) -> int:
+    from teamsim import bench
+
+    if args.what == "physics":
+        bench.physics(seconds=args.seconds or 20.0)
+    else:
+        bench.render(seconds=args.seconds or 4.0)
+    return 0
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = _build_parser()
+    try:
+        args = parser.parse_args(argv)
+        return {"run": cmd_run, "list": cmd_list, "render": cmd_render, "export": cmd_export,
+                "bench": cmd_bench}[args.command](args)
+    except (UsageError, ConfigError, RenderBackendError) as exc:
+        print(f"teamsim: error: {exc}", file=sys.stderr)
+        return EXIT_USAGE
+
+
+if __name__ == "__main__":
+    sys.exit(main())

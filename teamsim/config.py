@@ -1,0 +1,166 @@
+"""Typed, validated configuration: every tunable of a trial, with its default next to its meaning.
+
+A field is declared with :func:`setting`, which records its bounds and a one-line meaning. :func:`validate`
+checks a whole (nested) configuration, and :func:`apply_setting` parses one ``--set key=value`` into it. Both
+raise :class:`ConfigError` with a one-line message naming the field and what is allowed.
+"""
+from __future__ import annotations
+
+import dataclasses
+import math
+import typing
+from dataclasses import dataclass, field
+from typing import Any
+
+
+class ConfigError(ValueError):
+    """Bad configuration; the message names the field and what is allowed."""
+
+
+def setting(default: Any, *, lo: float | None = None, hi: float | None = None, choices: tuple = (),
+            open_lo: bool = False, meaning: str = "") -> Any:
+    """A validated dataclass field. ``lo``/``hi`` bound numbers (``open_lo`` excludes ``lo``)."""
+    meta = {"lo": lo, "hi": hi, "choices": choices, "open_lo": open_lo, "meaning": meaning}
+    return field(default=default, metadata=meta)
+
+
+@dataclass
+class Timing:
+    physics_dt: float = setting(0.002, lo=1e-4, hi=0.02, meaning="physics timestep, s (stable wheel, gripper, leg contacts)")
+    control_dt: float = setting(0.1, lo=0.01, hi=1.0, meaning="sensing/control period, s (Chand's explorers ran at 10 Hz)")
+    energy_dt: float = setting(0.01, lo=1e-4, hi=1.0, meaning="actuator power sampling period for energy, s")
+
+
+@dataclass
+class RadioConfig:
+    """Parker §2.2.3: one 10-byte broadcast per robot every 3 s, so rate 1/3 Hz and timeout tau = 3/rate."""
+    rate_hz: float = setting(1 / 3, lo=0.0, open_lo=True, hi=100.0, meaning="broadcasts per second per robot")
+    latency: float = setting(0.0, lo=0.0, hi=60.0, meaning="delivery delay, s")
+    loss: float = setting(0.0, lo=0.0, hi=1.0, meaning="probability a message is lost, per receiver")
+    range: float = setting(math.inf, lo=0.0, meaning="maximum sender-receiver distance, m")
+    timeout_periods: float = setting(3.0, lo=1.0, hi=100.0, meaning="tau in broadcast periods (tau = 3/rate)")
+
+    @property
+    def timeout(self) -> float:
+        return self.timeout_periods / self.rate_hz
+
+
+@dataclass
+class PositioningConfig:
+    """Parker §2.2.3: x,y updated every 600 ms, accurate to 1/2 in still and about 6 in while moving.
+
+    The thesis gives accuracies, not distributions: we read them as the standard deviation of Gaussian noise
+    on each axis. It gives no heading source; the thesis simulator had a compass (§2.1), so a heading with
+    its own noise is provided.
+    """
+    period: float = setting(0.6, lo=0.0, open_lo=True, hi=60.0, meaning="update period, s")
+    noise_still: float = setting(0.0127, lo=0.0, hi=10.0, meaning="position std dev per axis when still, m")
+    noise_moving: float = setting(0.15, lo=0.0, hi=10.0, meaning="position std dev per axis when moving, m")
+    moving_speed: float = setting(0.02, lo=0.0, hi=10.0, meaning="speed above which a robot counts as moving, m/s")
+    heading_noise: float = setting(0.05, lo=0.0, hi=math.pi, meaning="compass std dev, rad")
+
+
+@dataclass
+class VideoConfig:
+    enabled: bool = setting(False, meaning="render video.mp4 while running")
+    fps: int = setting(30, lo=1, hi=120, meaning="video frame rate (also the trajectory sampling rate)")
+    width: int = setting(640, lo=64, hi=3840, meaning="frame width, px")
+    height: int = setting(480, lo=48, hi=2160, meaning="frame height, px")
+    camera: str = setting("top", meaning="camera: 'top' or ROBOT/track")
+
+
+@dataclass
+class TrialConfig:
+    """Everything that defines one trial. ``params`` is the mission's own parameter dataclass."""
+    mission: str
+    params: Any
+    seed: int = setting(0, lo=0, hi=2**63 - 1, meaning="trial seed; every random stream derives from it")
+    duration: float | None = setting(None, lo=0.0, open_lo=True, hi=1e7, meaning="simulated seconds (mission default if unset)")
+    out: str = setting("renders", meaning="output root; a run writes OUT/<mission>/<run-id>/")
+    run_id: str | None = setting(None, meaning="run folder name (default: seed and a timestamp)")
+    timing: Timing = field(default_factory=Timing)
+    radio: RadioConfig = field(default_factory=RadioConfig)
+    positioning: PositioningConfig = field(default_factory=PositioningConfig)
+    video: VideoConfig = field(default_factory=VideoConfig)
+    faults: list = field(default_factory=list)
+
+
+def _check_value(name: str, value: Any, meta: dict) -> None:
+    if meta.get("choices") and value not in meta["choices"]:
+        raise ConfigError(f"{name}={value!r}: allowed values are {', '.join(map(str, meta['choices']))}")
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        return
+    if isinstance(value, float) and math.isnan(value):
+        raise ConfigError(f"{name}: NaN is not allowed")
+    lo, hi = meta.get("lo"), meta.get("hi")
+    below = lo is not None and (value <= lo if meta.get("open_lo") else value < lo)
+    if below or (hi is not None and value > hi):
+        low = "-inf" if lo is None else f"{lo:g}"
+        bracket = "(" if meta.get("open_lo") else "["
+        high = "inf" if hi is None else f"{hi:g}"
+        raise ConfigError(f"{name}={value!r}: must be in {bracket}{low}, {high}]")
+
+
+def validate(obj: Any, prefix: str = "") -> None:
+    """Check every field of a (nested) configuration dataclass against its bounds."""
+    for f in dataclasses.fields(obj):
+        value = getattr(obj, f.name)
+        name = prefix + f.name
+        if dataclasses.is_dataclass(value):
+            validate(value, "" if f.name == "params" else name + ".")
+        elif value is not None:
+            _check_value(name, value, f.metadata)
+    post = getattr(obj, "check", None)
+    if callable(post):
+        post()
+
+
+def _parse_scalar(name: str, text: str, kind: Any) -> Any:
+    """Parse ``text`` as ``kind`` (bool, int, float, str or Optional of one of those)."""
+    args = [a for a in typing.get_args(kind) if a is not type(None)]
+    if args:  # Optional[X]
+        if text.lower() in ("none", "null", ""):
+            return None
+        kind = args[0]
+    try:
+        if kind is bool:
+            lowered = text.lower()
+            if lowered in ("1", "true", "yes", "on"):
+                return True
+            if lowered in ("0", "false", "no", "off"):
+                return False
+            raise ValueError
+        if kind is int:
+            return int(text)
+        if kind is float:
+            return float(text)
+    except ValueError:
+        expected = {bool: "true or false", int: "an integer", float: "a number"}[kind]
+        raise ConfigError(f"--set {name}={text}: expected {expected}") from None
+    return text
+
+
+def settable_keys(cfg: TrialConfig) -> list[str]:
+    """Every key ``--set`` accepts: the mission's own parameters bare, the others dotted."""
+    keys = [f.name for f in dataclasses.fields(cfg.params)]
+    for group in ("timing", "radio", "positioning", "video"):
+        keys += [f"{group}.{f.name}" for f in dataclasses.fields(getattr(cfg, group))]
+    return keys
+
+
+def apply_setting(cfg: TrialConfig, assignment: str) -> None:
+    """Apply one ``key=value`` to ``cfg`` in place, with type coercion and bounds checking."""
+    key, sep, text = assignment.partition("=")
+    key = key.strip()
+    if not sep or not key:
+        raise ConfigError(f"--set {assignment!r}: expected key=value")
+    group, dot, leaf = key.rpartition(".")
+    target = getattr(cfg, group, None) if dot else cfg.params
+    fields = {f.name: f for f in dataclasses.fields(target)} if dataclasses.is_dataclass(target) else {}
+    if group in ("params",) or leaf not in fields:
+        raise ConfigError(f"--set {key}: unknown key for mission {cfg.mission!r}; "
+                          f"allowed: {', '.join(settable_keys(cfg))}")
+    kind = typing.get_type_hints(type(target))[leaf]
+    value = _parse_scalar(key, text.strip(), kind)
+    _check_value(key, value, fields[leaf].metadata)
+    setattr(target, leaf, value)

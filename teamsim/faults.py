@@ -1,0 +1,101 @@
+"""Faults as scenario data: what goes wrong, to which robot, and when (DESIGN.md, "Faults").
+
+CLI form: ``KIND:ROBOT@SECONDS[,key=value...]``, e.g. ``kill:red@60``, ``blind-ir:green@30``,
+``radio-off:blue@0``, ``slow:red@10,factor=0.5``, ``break-motor:red@5,motor=left``,
+``add-robot:purple@20,kind=diffdrive``. The world applies each fault at its time and records an event; a
+fault only changes a robot's :class:`Health`, which the world consults when sensing and actuating.
+"""
+from __future__ import annotations
+
+import math
+import re
+from dataclasses import dataclass, field
+
+from teamsim.config import ConfigError
+
+# kind -> {option: (parser, default, meaning)}
+FAULT_OPTIONS: dict[str, dict[str, tuple]] = {
+    "kill": {},
+    "blind-ir": {},
+    "radio-off": {},
+    "radio-on": {},
+    "break-motor": {"motor": (str, None, "locomotion motor name (default: the first)")},
+    "slow": {"factor": (float, 0.5, "speed multiplier in (0, 1]")},
+    "break-gripper": {},
+    "add-robot": {"kind": (str, "diffdrive", "robot kind of the newcomer")},
+}
+FAULT_KINDS = tuple(FAULT_OPTIONS)
+_SPEC = re.compile(r"^(?P<kind>[a-z-]+):(?P<robot>[A-Za-z0-9_-]+)@(?P<time>[^,]+)(?P<rest>(,[^,=]+=[^,]*)*)$")
+SPEC_FORM = "KIND:ROBOT@SECONDS[,key=value...]"
+
+
+@dataclass(frozen=True)
+class Fault:
+    kind: str
+    robot: str
+    time: float
+    options: dict = field(default_factory=dict)
+
+    def describe(self) -> dict:
+        return {"kind": self.kind, "robot": self.robot, "time": self.time, **self.options}
+
+
+@dataclass
+class Health:
+    """What faults have done to one robot so far."""
+    alive: bool = True
+    ir_blind: bool = False
+    radio_on: bool = True
+    gripper_broken: bool = False
+    speed_factor: float = 1.0
+    broken_motors: set = field(default_factory=set)
+
+
+def parse_fault(spec: str) -> Fault:
+    """Parse one ``--fault`` spec; raise ConfigError with a one-line reason."""
+    match = _SPEC.match(spec.strip())
+    if not match:
+        raise ConfigError(f"--fault {spec!r}: expected {SPEC_FORM}, e.g. kill:red@60")
+    kind = match["kind"]
+    if kind not in FAULT_OPTIONS:
+        raise ConfigError(f"--fault {spec!r}: unknown kind {kind!r}; allowed: {', '.join(FAULT_KINDS)}")
+    try:
+        time = float(match["time"])
+    except ValueError:
+        raise ConfigError(f"--fault {spec!r}: time {match['time']!r} is not a number of seconds") from None
+    if not math.isfinite(time) or time < 0:
+        raise ConfigError(f"--fault {spec!r}: time must be a finite number of seconds >= 0")
+    allowed = FAULT_OPTIONS[kind]
+    options = {key: default for key, (_, default, _) in allowed.items() if default is not None}
+    for pair in filter(None, match["rest"].split(",")):
+        key, _, text = pair.partition("=")
+        if key not in allowed:
+            names = ", ".join(allowed) or "none"
+            raise ConfigError(f"--fault {spec!r}: unknown option {key!r} for {kind}; allowed: {names}")
+        try:
+            options[key] = allowed[key][0](text)
+        except ValueError:
+            raise ConfigError(f"--fault {spec!r}: {key}={text!r} is not a valid {allowed[key][0].__name__}") from None
+    if kind == "slow" and not 0.0 < options["factor"] <= 1.0:
+        raise ConfigError(f"--fault {spec!r}: factor must be in (0, 1]")
+    return Fault(kind, match["robot"], time, options)
+
+
+def apply_fault(fault: Fault, health: Health, motor_names: tuple[str, ...]) -> None:
+    """Change ``health`` as ``fault`` says (add-robot is the world's job: it has no health to change)."""
+    kind = fault.kind
+    if kind == "kill":
+        health.alive = False
+        health.radio_on = False
+    elif kind == "blind-ir":
+        health.ir_blind = True
+    elif kind == "radio-off":
+        health.radio_on = False
+    elif kind == "radio-on":
+        health.radio_on = health.alive
+    elif kind == "break-motor":
+        health.broken_motors.add(fault.options.get("motor") or motor_names[0])
+    elif kind == "slow":
+        health.speed_factor *= fault.options["factor"]
+    elif kind == "break-gripper":
+        health.gripper_broken = True

@@ -1,0 +1,151 @@
+"""The trial runner: ``run_trial(config, seed)`` runs one mission and writes its outputs (DESIGN.md, "A
+trial's outputs").
+
+A trial ends ``completed`` or ``failed`` (the mission's verdict), ``unstable`` (NaN/Inf or a MuJoCo warning
+that invalidates the physics), ``error`` (a Python exception) or ``interrupted`` (Ctrl-C). Whatever the ending,
+the summary, the events so far and the trajectory so far are saved.
+"""
+from __future__ import annotations
+
+import dataclasses
+import hashlib
+import time
+import traceback
+from dataclasses import dataclass
+from datetime import datetime, timezone
+from pathlib import Path
+
+import mujoco
+import numpy as np
+
+import teamsim
+from teamsim.config import ConfigError, TrialConfig, validate
+from teamsim.progress import Progress
+from teamsim.recording import EventLog, TrajectoryRecorder, write_json
+from teamsim.tasks import MISSIONS
+from teamsim.world import PhysicsUnstable, World
+
+
+@dataclass(frozen=True)
+class TrialResult:
+    status: str
+    run_dir: Path
+    summary: dict
+
+    @property
+    def completed(self) -> bool:
+        return self.status == "completed"
+
+
+def mission_of(name: str):
+    if name not in MISSIONS:
+        raise ConfigError(f"unknown mission {name!r}; known: {', '.join(MISSIONS)}")
+    return MISSIONS[name]
+
+
+def make_run_dir(config: TrialConfig) -> Path:
+    """Create ``OUT/<mission>/<run-id>/``; an unwritable OUT is a ConfigError naming it."""
+    run_id = config.run_id or f"seed{config.seed}-{datetime.now(timezone.utc):%Y%m%d-%H%M%S}"
+    parent = Path(config.out) / config.mission
+    try:
+        parent.mkdir(parents=True, exist_ok=True)
+        run_dir, suffix = parent / run_id, 1
+        while run_dir.exists() and any(run_dir.iterdir()):
+            suffix += 1
+            run_dir = parent / f"{run_id}-{suffix}"
+        run_dir.mkdir(exist_ok=True)
+        probe = run_dir / ".write-test"
+        probe.write_bytes(b"")
+        probe.unlink()
+    except OSError as exc:
+        raise ConfigError(f"--out {config.out}: not writable ({exc.strerror or exc})") from None
+    return run_dir
+
+
+def state_digest(world: World) -> str:
+    """SHA-256 of MuJoCo's full integration state: equal digests mean bit-identical simulations."""
+    spec = mujoco.mjtState.mjSTATE_INTEGRATION
+    state = np.empty(mujoco.mj_stateSize(world.model, spec))
+    mujoco.mj_getState(world.model, world.data, state, spec)
+    return hashlib.sha256(state.tobytes()).hexdigest()
+
+
+def run_trial(config: TrialConfig, seed: int | None = None, progress: bool | None = None) -> TrialResult:
+    """Run one trial and write its outputs. ``seed`` overrides ``config.seed``. Bad configuration raises
+    ConfigError before anything is written; everything after that ends in a saved summary."""
+    if seed is not None:
+        config = dataclasses.replace(config, seed=seed)
+    validate(config)
+    mission = mission_of(config.mission)
+    duration = config.duration or mission.default_duration
+    world = World(config, mission)
+    renderer = writer = None
+    if config.video.enabled:
+        from teamsim.video import FrameRenderer, Mp4Writer  # imports GL only when a video is asked for
+        try:
+            renderer = FrameRenderer(world.xml, list(world.robots), config.video.width, config.video.height,
+                                     config.video.camera)
+        except ValueError as exc:
+            raise ConfigError(f"video.camera: {exc}") from None
+    run_dir = make_run_dir(config)
+    summary = {"mission": config.mission, "seed": config.seed, "run_id": run_dir.name, "status": "running",
+               "completed": False, "duration_s": duration, "teamsim": teamsim.__version__,
+               "mujoco": mujoco.__version__, "config": dataclasses.asdict(config)}
+    write_json(run_dir / "summary.json", summary)
+    events = EventLog(run_dir / "events.jsonl")
+    world.record = events
+    recorder = TrajectoryRecorder(world.xml, list(world.robots), config.video.fps, world.physics_dt)
+    if renderer is not None:
+        writer = Mp4Writer(run_dir / "video.mp4", config.video.width, config.video.height, config.video.fps)
+    bar = Progress(duration, f"{config.mission} seed {config.seed}", enabled=progress)
+    events({"t": 0.0, "event": "trial_start", "mission": config.mission, "seed": config.seed,
+            "robots": list(world.robots)})
+
+    def capture() -> None:
+        if world.step != recorder.next_step:
+            return
+        behaviours = [r.behaviour if r.active else ("dead" if not r.health.alive else "absent")
+                      for r in world.robots.values()]
+        recorder.capture(world.time, world.data.qpos, behaviours)
+        if writer is not None:
+            writer.write(renderer.render(world.time, world.data.qpos, behaviours))
+
+    status, error, completed, metrics = "running", None, False, {}
+    started = time.perf_counter()
+    end_step = round(duration / world.physics_dt)
+    try:
+        while world.step < end_step and not mission.done(world):
+            world.tick()
+            capture()
+            tick_end = min(world.step + world.steps_per_tick, end_step)
+            while world.step < tick_end:
+                frame_step = recorder.next_step
+                world.advance((frame_step if world.step < frame_step < tick_end else tick_end) - world.step)
+                capture()
+            bar.update(world.time)
+        completed, metrics = mission.outcome(world)
+        status = "completed" if completed else "failed"
+    except PhysicsUnstable as exc:
+        status, error = "unstable", str(exc)
+    except KeyboardInterrupt:
+        status, error = "interrupted", "interrupted by the user"
+    except Exception as exc:  # noqa: BLE001  (any failure must still leave a summary)
+        status, error = "error", f"{type(exc).__name__}: {exc}"
+        events({"t": round(world.time, 6), "event": "exception", "traceback": traceback.format_exc()})
+    finally:
+        bar.finish()
+        events({"t": round(world.time, 6), "event": "trial_end", "status": status})
+        events.close()
+        recorder.save(run_dir / "trajectory.npz")
+        if writer is not None:
+            writer.close()
+            renderer.close()
+        wall = time.perf_counter() - started
+        summary.update(status=status, completed=status == "completed", error=error,
+                       sim_time_s=round(world.time, 6), wall_time_s=round(wall, 3),
+                       real_time_factor=round(world.time / wall, 2) if wall > 0 else None,
+                       metrics=metrics, robots=world.robot_summary(), final_state_sha256=state_digest(world),
+                       faults=[f.describe() for f in config.faults],
+                       outputs=sorted(p.name for p in run_dir.iterdir() if p.name != "summary.json"))
+        write_json(run_dir / "summary.json", summary)
+    return TrialResult(status, run_dir, summary)
