@@ -32,7 +32,8 @@ class DiffDriveDims:
     wheel_radius: float = 0.08
     wheel_width: float = 0.03
     wheel_inset: float = 0.08  # wheel centre inside the rim, so wheels sit in body slots
-    wheel_torque: float = 6.0  # N m per wheel motor
+    wheel_torque: float = 6.0  # N m per wheel motor (stall)
+    wheel_servo_gain: float = 30.0  # N m per rad/s of speed error: stiff enough to hold speed within ~1 %
     caster_radius: float = 0.03
     caster_gap: float = 0.004  # casters ride this far above the floor so the wheels carry the load
     battery_mass: float = 3.0  # kg, ahead of the axle: the robot leans on its front caster, not its back one
@@ -71,7 +72,7 @@ def build(name: str, dims: DiffDriveDims = DiffDriveDims()) -> RobotModel:
         wheel.add("joint", name=side, type="hinge", axis=[0, 1, 0], damping=0.05)
         wheel.add("geom", name=f"{side}_tyre", type="cylinder", size=[dims.wheel_radius, dims.wheel_width / 2],
                   zaxis=[0, 1, 0], mass=0.5, friction=[1.2, 0.01, 0.001], rgba=[0.1, 0.1, 0.1, 1])
-        model.actuator.add("velocity", name=side, joint=side, kv=dims.wheel_torque,
+        model.actuator.add("velocity", name=side, joint=side, kv=dims.wheel_servo_gain,
                            forcerange=[-dims.wheel_torque, dims.wheel_torque], forcelimited=True,
                            ctrlrange=[-dims.v_max / dims.wheel_radius * 1.5, dims.v_max / dims.wheel_radius * 1.5])
         motors.append(side)

@@ -37,7 +37,8 @@ class Fault:
     options: dict = field(default_factory=dict)
 
     def describe(self) -> dict:
-        return {"kind": self.kind, "robot": self.robot, "time": self.time, **self.options}
+        described = {"kind": self.kind, "robot": self.robot, "time": self.time}
+        return {**described, "options": dict(self.options)} if self.options else described
 
 
 @dataclass

@@ -9,7 +9,8 @@ import time
 
 
 class Progress:
-    def __init__(self, total: float, label: str, enabled: bool | None = None, stream=sys.stderr):
+    def __init__(self, total: float, label: str, enabled: bool | None = None, stream=None):
+        stream = stream or sys.stderr
         self.total, self.label, self.stream = total, label, stream
         self.enabled = stream.isatty() if enabled is None else enabled
         self.start = time.perf_counter()

@@ -70,6 +70,28 @@ def state_digest(world: World) -> str:
     return hashlib.sha256(state.tobytes()).hexdigest()
 
 
+def simulate(world: World, mission, duration: float, recorder: TrajectoryRecorder, on_frame,
+             on_tick=lambda sim_time: None) -> None:
+    """Run the control loop to ``duration`` (or until the mission is done), calling ``on_frame()`` at every
+    frame step of ``recorder`` and ``on_tick(time)`` after every control period."""
+    end_step = round(duration / world.physics_dt)
+
+    def at_frame() -> None:
+        if world.step == recorder.next_step:
+            on_frame()
+
+    while world.step < end_step and not mission.done(world):
+        world.tick()
+        at_frame()
+        tick_end = min(world.step + world.steps_per_tick, end_step)
+        while world.step < tick_end:
+            frame_step = recorder.next_step
+            world.advance((frame_step if world.step < frame_step < tick_end else tick_end) - world.step)
+            at_frame()
+        on_tick(world.time)
+    world.check_stable()
+
+
 def run_trial(config: TrialConfig, seed: int | None = None, progress: bool | None = None) -> TrialResult:
     """Run one trial and write its outputs. ``seed`` overrides ``config.seed``. Bad configuration raises
     ConfigError before anything is written; everything after that ends in a saved summary."""
@@ -102,8 +124,6 @@ def run_trial(config: TrialConfig, seed: int | None = None, progress: bool | Non
             "robots": list(world.robots)})
 
     def capture() -> None:
-        if world.step != recorder.next_step:
-            return
         behaviours = [r.behaviour if r.active else ("dead" if not r.health.alive else "absent")
                       for r in world.robots.values()]
         recorder.capture(world.time, world.data.qpos, behaviours)
@@ -112,17 +132,8 @@ def run_trial(config: TrialConfig, seed: int | None = None, progress: bool | Non
 
     status, error, completed, metrics = "running", None, False, {}
     started = time.perf_counter()
-    end_step = round(duration / world.physics_dt)
     try:
-        while world.step < end_step and not mission.done(world):
-            world.tick()
-            capture()
-            tick_end = min(world.step + world.steps_per_tick, end_step)
-            while world.step < tick_end:
-                frame_step = recorder.next_step
-                world.advance((frame_step if world.step < frame_step < tick_end else tick_end) - world.step)
-                capture()
-            bar.update(world.time)
+        simulate(world, mission, duration, recorder, capture, bar.update)
         completed, metrics = mission.outcome(world)
         status = "completed" if completed else "failed"
     except PhysicsUnstable as exc:

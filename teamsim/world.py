@@ -54,7 +54,6 @@ class Robot:
     behaviour: str = "idle"
     parker_energy: float = 0.0  # Parker's count: 1 unit per second while any motor is commanded
     behaviour_time: dict = field(default_factory=dict)
-    touching_s: float = 0.0
     # model indices, filled by World
     qpos_adr: int = 0
     qvel_adr: int = 0
@@ -93,6 +92,11 @@ class World:
         scene = mission.build(config.params, self.streams.get("mission", "layout"), newcomers, timing.physics_dt)
         self.robots: dict[str, Robot] = {}
         for slot in scene.robots:
+            if slot.name in self.robots:
+                raise ConfigError(f"--fault add-robot:{slot.name}: robot {slot.name!r} is already in the team")
+            if slot.kind not in ROBOT_BUILDERS:
+                raise ConfigError(f"robot {slot.name!r}: kind {slot.kind!r} is not available; "
+                                  f"available: {', '.join(ROBOT_BUILDERS)}")
             model = build_robot(slot.kind, slot.name)
             frame = scene.arena.attach(model.mjcf)
             frame.add("freejoint")
@@ -127,11 +131,7 @@ class World:
             robot = self.robots.get(fault.robot)
             spec = f"--fault {fault.kind}:{fault.robot}@{fault.time:g}"
             if fault.kind == "add-robot":
-                if fault.options["kind"] not in ROBOT_BUILDERS:
-                    raise ConfigError(f"{spec}: kind must be one of {', '.join(ROBOT_BUILDERS)}")
-                if not robot.dormant:
-                    raise ConfigError(f"{spec}: robot {fault.robot!r} is already in the team")
-                continue
+                continue  # checked as the team is built
             if robot is None:
                 raise ConfigError(f"{spec}: no robot {fault.robot!r}; team: {', '.join(self.robots)}")
             if fault.kind == "break-motor" and fault.options.get("motor") not in (None, *robot.model.motors):
@@ -160,11 +160,11 @@ class World:
         self._geom_owner = np.full(m.ngeom, -1)
         for k, robot in enumerate(self.robots.values()):
             self._geom_owner[robot.geoms] = k
-        self._floor = set(np.flatnonzero(m.geom_type == mujoco.mjtGeom.mjGEOM_PLANE).tolist())
+        self._is_floor = m.geom_type == mujoco.mjtGeom.mjGEOM_PLANE
+        self._touching_s = np.zeros(len(self.robots))
         self._names = list(self.robots)
         self._root_dofs = np.array([r.qvel_adr for r in self.robots.values()])
-        self._joined = np.array([not r.dormant for r in self.robots.values()])
-        self.energy_j = np.zeros(len(self.robots))
+        self._actuator_energy_j = np.zeros(len(self._all_actuators))
         self.odometry_m = np.zeros(len(self.robots))
 
     # -- state ----------------------------------------------------------------------------------------------
@@ -186,11 +186,14 @@ class World:
                 if not r.dormant}
 
     def contact_fraction(self) -> dict[str, float]:
-        return {name: round(r.touching_s / max(self.time, 1e-9), 6) for name, r in self.robots.items()}
+        """Share of the trial each robot spent touching walls, obstacles or other robots."""
+        return {name: round(float(self._touching_s[k]) / max(self.time, 1e-9), 6)
+                for k, name in enumerate(self.robots)}
 
     # -- the control tick -----------------------------------------------------------------------------------
     def tick(self) -> None:
         """Apply due faults, sense, decide and set actuators, at the current time."""
+        self.check_stable()
         now = self.time
         while self.faults and self.faults[0].time <= now + 1e-9:
             self._apply(self.faults.pop(0), now)
@@ -204,26 +207,37 @@ class World:
         self.positioning.update(now, poses, {r.name: self.speed(r) for r in live})
         for message in self.radio.update(now, poses):
             self.record({"t": round(now, 6), "event": "radio", "robot": message.sender, "payload": message.payload})
-        touching = self._robots_touching()
-        for robot in self.robots.values():
-            if robot.dormant:
-                continue
-            if robot.name in touching:
-                robot.touching_s += self.control_dt
-            if robot.health.alive:
-                self._control(robot, now)
+        for k in self._robots_touching():
+            self._touching_s[k] += self.control_dt
+        for robot, (raw, ranges) in zip(live, self._read_ir(live)):
+            self._control(robot, now, raw, ranges)
 
-    def _control(self, robot: Robot, now: float) -> None:
+    def _read_ir(self, robots: list[Robot]) -> list[tuple[np.ndarray, np.ndarray]]:
+        """(raw, range) IR readings per robot, one vectorised IR-model call per sensor model."""
+        readings: list = [None] * len(robots)
+        groups: dict = {}
+        for k, robot in enumerate(robots):
+            groups.setdefault(robot.model.ir, []).append(k)
+        for ir, members in groups.items():
+            distance = self.data.sensordata[np.concatenate([robots[k].ir_adr for k in members])]
+            # Each robot draws from its own stream, blind or not, so one robot's faults never shift another's.
+            noise = np.concatenate([robots[k].ir_rng.standard_normal(len(robots[k].ir_adr)) for k in members])
+            blind = np.concatenate([np.full(len(robots[k].ir_adr), robots[k].health.ir_blind) for k in members])
+            raw = np.where(blind, 0.0, ir.read(distance, noise))
+            ranges = ir.to_range(raw)
+            bounds = np.cumsum([0] + [len(robots[k].ir_adr) for k in members])
+            for k, lo, hi in zip(members, bounds[:-1], bounds[1:]):
+                readings[k] = (raw[lo:hi], ranges[lo:hi])
+        return readings
+
+    def _control(self, robot: Robot, now: float, ir_raw: np.ndarray, ir_range: np.ndarray) -> None:
         d = self.data
-        distance = d.sensordata[robot.ir_adr]
-        noise = robot.ir_rng.standard_normal(distance.shape)  # drawn even when blind: streams stay aligned
-        raw = np.zeros_like(distance) if robot.health.ir_blind else robot.model.ir.read(distance, noise)
         observation = Observation(
-            time=now, robot=robot.name, ir_raw=raw, ir_range=robot.model.ir.to_range(raw),
+            time=now, robot=robot.name, ir_raw=ir_raw, ir_range=ir_range,
             ir_bearings=robot.model.ir_bearings, pose=self.positioning.fix(robot.name),
             inbox=tuple(self.radio.take_inbox(robot.name)),
             robots_present=self.radio.robots_present(robot.name, now),
-            wheel_speeds=d.qvel[robot.wheel_dofs].copy())
+            wheel_speeds=d.qvel[robot.wheel_dofs])
         command: Command = robot.controller(observation)
         if command.behaviour != robot.behaviour:
             self.record({"t": round(now, 6), "event": "behaviour", "robot": robot.name,
@@ -232,27 +246,20 @@ class World:
         robot.behaviour_time[robot.behaviour] = robot.behaviour_time.get(robot.behaviour, 0.0) + self.control_dt
         if command.broadcast is not None:
             self.radio.set_outbox(robot.name, command.broadcast)
-        wheels = robot.drive.wheel_speeds(command.v, command.omega) * robot.health.speed_factor
         if command.v or command.omega:
             robot.parker_energy += self.control_dt
-        d.ctrl[robot.actuators] = wheels
+        d.ctrl[robot.actuators] = robot.drive.wheel_speeds(command.v, command.omega) * robot.health.speed_factor
 
-    def _robots_touching(self) -> set[str]:
-        """Robots with a contact against anything but the floor (walls, obstacles, other robots)."""
+    def _robots_touching(self) -> np.ndarray:
+        """Indices of robots in contact with anything but the floor (walls, obstacles, other robots)."""
         d = self.data
         if d.ncon == 0:
-            return set()
+            return np.zeros(0, dtype=int)
         pairs = d.contact.geom[: d.ncon]
         owners = self._geom_owner[pairs]
-        floor = self._floor
-        hit = set()
-        for (g1, g2), (o1, o2) in zip(pairs, owners):
-            if o1 == o2 or g1 in floor or g2 in floor:
-                continue
-            for owner in (o1, o2):
-                if owner >= 0:
-                    hit.add(self._names[owner])
-        return hit
+        relevant = (owners[:, 0] != owners[:, 1]) & ~self._is_floor[pairs].any(axis=1)
+        hit = owners[relevant].ravel()
+        return np.unique(hit[hit >= 0])
 
     def _apply(self, fault: Fault, now: float) -> None:
         robot = self.robots[fault.robot]
@@ -280,7 +287,6 @@ class World:
         q[robot.qpos_adr:robot.qpos_adr + 7] = [x, y, 0.002, math.cos(yaw / 2), 0, 0, math.sin(yaw / 2)]
         self.data.qvel[robot.qvel_adr:robot.qvel_adr + 6] = 0
         robot.dormant = False
-        self._joined[self._names.index(robot.name)] = True
         mujoco.mj_forward(self.model, self.data)
 
     # -- physics --------------------------------------------------------------------------------------------
@@ -293,21 +299,26 @@ class World:
             mujoco.mj_step(m, d, nstep=chunk)
             self.step += chunk
             self._sample_power(chunk * self.physics_dt)
-        self._check_stable()
 
     def _sample_power(self, dt: float) -> None:
         """Integrate |force x velocity| of every actuator, and odometry, over the last ``dt`` seconds."""
         d, ids = self.data, self._all_actuators
-        power = np.abs(d.actuator_force[ids] * d.actuator_velocity[ids])
-        self.energy_j += np.bincount(self._actuator_owner, power, minlength=len(self.robots)) * dt
-        speed = np.hypot(d.qvel[self._root_dofs], d.qvel[self._root_dofs + 1])
-        self.odometry_m += np.where(self._joined, speed, 0.0) * dt
+        self._actuator_energy_j += np.abs(d.actuator_force[ids] * d.actuator_velocity[ids]) * dt
+        # Parked (dormant) robots stand still, so they add nothing here.
+        self.odometry_m += np.hypot(d.qvel[self._root_dofs], d.qvel[self._root_dofs + 1]) * dt
 
-    def _check_stable(self) -> None:
+    @property
+    def energy_j(self) -> np.ndarray:
+        """Mechanical energy each robot's actuators have delivered, J (integral of |force x velocity|)."""
+        return np.bincount(self._actuator_owner, self._actuator_energy_j, minlength=len(self.robots))
+
+    def check_stable(self) -> None:
+        """Raise PhysicsUnstable on NaN/Inf state or a warning that invalidates the physics."""
         d = self.data
-        for w in UNSTABLE_WARNINGS:
-            if d.warning[w].number:
-                raise PhysicsUnstable(f"MuJoCo warning {mujoco.mjtWarning(w).name} at t={self.time:.3f} s")
+        raised = d.warning.number[list(UNSTABLE_WARNINGS)]
+        if raised.any():
+            name = mujoco.mjtWarning(UNSTABLE_WARNINGS[int(np.argmax(raised > 0))]).name
+            raise PhysicsUnstable(f"MuJoCo warning {name} at t={self.time:.3f} s")
         if not (np.isfinite(d.qpos).all() and np.isfinite(d.qvel).all()):
             raise PhysicsUnstable(f"non-finite state at t={self.time:.3f} s")
 
