@@ -59,8 +59,9 @@ class IRModel:
         distance = np.asarray(distance, dtype=float)
         clean = self.response(distance)
         sigma = np.interp(distance, self._d, self._noise) * clean
-        noisy = np.clip(clean + sigma * noise, 0.0, self._r[0])
-        return np.round(noisy / self.resolution) * self.resolution
+        levels = np.round((clean + sigma * noise) / self.resolution)
+        # Clip in quantisation levels, so a reading is always a multiple of the resolution within full scale.
+        return np.clip(levels, 0.0, np.floor(self._r[0] / self.resolution)) * self.resolution
 
     def to_range(self, raw: np.ndarray) -> np.ndarray:
         """Range estimates (m) from raw readings, by inverting the calibration; ``inf`` where nothing is seen."""

@@ -22,6 +22,12 @@ class PoseFix:
     time: float
 
 
+def wrap_angle(angle: float) -> float:
+    """``angle`` in [-pi, pi). (The modulo alone can round up to exactly +pi.)"""
+    wrapped = (angle + np.pi) % (2 * np.pi) - np.pi
+    return wrapped - 2 * np.pi if wrapped >= np.pi else wrapped
+
+
 class PositioningService:
     def __init__(self, config: PositioningConfig, rngs: dict[str, np.random.Generator]):
         self.config = config
@@ -37,7 +43,7 @@ class PositioningService:
         for name, pose in poses.items():
             sigma = cfg.noise_moving if speeds[name] > cfg.moving_speed else cfg.noise_still
             noise = self._rngs[name].standard_normal(3)
-            heading = (pose[2] + cfg.heading_noise * noise[2] + np.pi) % (2 * np.pi) - np.pi
+            heading = wrap_angle(pose[2] + cfg.heading_noise * noise[2])
             self._fixes[name] = PoseFix(float(pose[0] + sigma * noise[0]), float(pose[1] + sigma * noise[1]),
                                         float(heading), now)
         while self._next_update <= now + 1e-9:

@@ -102,6 +102,22 @@ def test_loss_fraction_matches_configured_probability():
     assert abs(lost - pairs * loss) <= 4 * sigma, (lost, pairs * loss, sigma)
 
 
+def test_loss_is_drawn_independently_per_receiver():
+    names = [f"r{i}" for i in range(5)]
+    loss = 0.5
+    bus = make_bus(names, rate_hz=10.0, loss=loss)
+    sent, received = run(bus, names, 50.0, dt=0.1)
+    copies = {}
+    for name in names:
+        for message in received[name]:
+            copies[(message.sender, message.sent_at)] = copies.get((message.sender, message.sent_at), 0) + 1
+    counts = np.bincount([copies.get((m.sender, m.sent_at), 0) for m in sent], minlength=5)
+    # Copies per message ~ Binomial(4, 1/2): 1/16, 4/16, 6/16, 4/16, 1/16 of 2500 messages.
+    expected = len(sent) * np.array([1, 4, 6, 4, 1]) / 16
+    sigma = np.sqrt(expected * (1 - expected / len(sent)))
+    assert np.all(np.abs(counts - expected) <= 4 * sigma), (counts, expected)
+
+
 @pytest.mark.parametrize("loss, expect_all", [(0.0, True), (1.0, False)])
 def test_loss_extremes(loss, expect_all):
     names = ["a", "b", "c"]
