@@ -95,12 +95,16 @@ class TrajectoryRecorder:
         self.qpos.append(qpos.copy())
         self.behaviours.append(list(behaviours))
 
+    def behaviour_array(self) -> np.ndarray:
+        """Behaviours as a (frames, robots) array of strings."""
+        return np.array(self.behaviours, dtype=str).reshape(len(self.times), len(self.robot_names))
+
     def save(self, path: Path) -> None:
         buffer = io.BytesIO()
         np.savez_compressed(
             buffer, model_xml=np.array(self.xml), robot_names=np.array(self.robot_names), fps=np.array(self.fps),
             time=np.array(self.times), qpos=np.array(self.qpos).reshape(len(self.times), -1),
-            behaviour=np.array(self.behaviours, dtype=str).reshape(len(self.times), len(self.robot_names)))
+            behaviour=self.behaviour_array())
         write_atomic(path, buffer.getvalue())
 
 

@@ -23,6 +23,7 @@ from teamsim.config import ConfigError, TrialConfig, validate
 from teamsim.progress import Progress
 from teamsim.recording import EventLog, TrajectoryRecorder, write_json
 from teamsim.tasks import MISSIONS
+from teamsim.timeline import write_timeline
 from teamsim.world import PhysicsUnstable, World
 
 
@@ -148,6 +149,9 @@ def run_trial(config: TrialConfig, seed: int | None = None, progress: bool | Non
         events({"t": round(world.time, 6), "event": "trial_end", "status": status})
         events.close()
         recorder.save(run_dir / "trajectory.npz")
+        if recorder.times:
+            write_timeline(run_dir / "timeline.png", recorder.times, recorder.behaviour_array(), recorder.robot_names,
+                           [f.describe() for f in config.faults])
         if writer is not None:
             writer.close()
             renderer.close()

@@ -31,7 +31,8 @@ def test_outputs_written(tmp_path):
     result = run_trial(quick_config(tmp_path))
     run_dir = tmp_path / "wander" / "run"
     assert result.run_dir == run_dir and result.status == "completed"
-    assert sorted(p.name for p in run_dir.iterdir()) == ["events.jsonl", "summary.json", "trajectory.npz"]
+    assert sorted(p.name for p in run_dir.iterdir()) == ["events.jsonl", "summary.json", "timeline.png",
+                                                             "trajectory.npz"]
     summary = json.loads((run_dir / "summary.json").read_text())
     assert summary["completed"] is True and summary["sim_time_s"] == pytest.approx(6.0)
     assert set(summary["robots"]) == {"red", "green", "blue", "yellow"}
