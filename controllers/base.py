@@ -23,7 +23,11 @@ class Observation:
     pose: Any  # latest positioning fix (teamsim.positioning.PoseFix) or None before the first
     inbox: tuple = ()  # radio messages received since the last tick
     robots_present: frozenset = frozenset()
-    wheel_speeds: np.ndarray = field(default_factory=lambda: np.zeros(0))  # encoders, rad/s
+    motor_speeds: np.ndarray = field(default_factory=lambda: np.zeros(0))  # locomotion encoders, rad/s
+    touch: dict = field(default_factory=dict)  # touch sensor -> summed contact normal force, N (bumpers, fingers)
+    break_beams: np.ndarray = field(default_factory=lambda: np.zeros(0, bool))  # True where a beam is broken
+    inclination: tuple | None = None  # (roll, pitch) in rad, for robots with an inclinometer
+    effectors: dict = field(default_factory=dict)  # effector -> position in [0, 1] from its encoder
 
 
 @dataclass(frozen=True)
@@ -32,7 +36,7 @@ class Command:
     omega: float = 0.0  # turn rate, rad/s (counter-clockwise positive)
     behaviour: str = "idle"
     broadcast: Any = None  # payload for the next radio slot; None keeps the previous one
-    extras: dict = field(default_factory=dict)  # robot-specific actuators, e.g. {"gripper": "close"}
+    extras: dict = field(default_factory=dict)  # effector set-points in [0, 1], e.g. {"grip": 0.0, "lift": 1.0}
 
 
 class Controller(Protocol):

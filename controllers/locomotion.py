@@ -1,36 +1,106 @@
-"""Locomotion: the common (v, omega) command turned into actuator set-points.
+"""Locomotion: the common (v, omega) command turned into actuator set-points, one class per drive.
 
-Differential drive (also used for skid-steer tracks): wheel angular speeds
-``w_left = (v - omega * b / 2) / r`` and ``w_right = (v + omega * b / 2) / r`` for track width ``b`` and wheel
-radius ``r``. The command is first clipped to the robot's speed limits and then slewed by its acceleration
-limits over one control period, as Chand's dynamic window assumes (eq. 3.11-3.12).
+Every drive first clips the command to the robot's speed limits and slews it by its acceleration limits over
+one control period, as Chand's dynamic window assumes (eq. 3.11-3.12). ``command`` is called once per control
+tick; ``targets(t)`` gives the actuator set-points, in the order of the drive spec's ``actuators``. A drive
+whose set-points change between ticks (a gait) sets ``continuous``, and the world asks it again during the
+period.
 """
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
+from teamsim.models.robot import DifferentialSpec, TricycleSpec
 
-class DifferentialDrive:
-    def __init__(self, wheel_radius: float, track_width: float, limits, control_dt: float):
-        self.r = wheel_radius
-        self.b = track_width
+
+class SlewLimiter:
+    """(v, omega) clipped to the speed limits and slewed by the acceleration limits, per control period."""
+
+    def __init__(self, limits, control_dt: float):
         self.limits = limits
         self.dt = control_dt
         self.v = 0.0
         self.omega = 0.0
 
-    def wheel_speeds(self, v: float, omega: float) -> np.ndarray:
-        """(left, right) wheel speeds in rad/s after speed and acceleration limiting."""
+    def __call__(self, v: float, omega: float) -> tuple[float, float]:
         lim = self.limits
         v = min(max(v, -lim.v_max), lim.v_max)
         omega = min(max(omega, -lim.omega_max), lim.omega_max)
         dv, dw = lim.accel_max * self.dt, lim.angular_accel_max * self.dt
         self.v += min(max(v - self.v, -dv), dv)
         self.omega += min(max(omega - self.omega, -dw), dw)
-        half = self.omega * self.b / 2
-        return np.array([(self.v - half) / self.r, (self.v + half) / self.r])
+        return self.v, self.omega
 
-    def stop(self) -> np.ndarray:
-        """Immediate stop (a dead robot's motors are unpowered, not ramped)."""
+    def reset(self) -> None:
         self.v = self.omega = 0.0
-        return np.zeros(2)
+
+
+class DifferentialDrive:
+    """``w_left = (v - omega b/2) / r``, ``w_right = (v + omega b/2) / r`` for track ``b``, wheel radius ``r``;
+    every actuator of a side gets its side's speed (the co-driven rollers of a skid-steer track too)."""
+    continuous = False
+
+    def __init__(self, spec, limits, control_dt: float):
+        self.spec = spec
+        self.slew = SlewLimiter(limits, control_dt)
+        self._sides = np.array([0] * len(spec.left) + [1] * len(spec.right))
+        self._speeds = np.zeros(2)
+
+    def command(self, v: float, omega: float) -> None:
+        v, omega = self.slew(v, omega)
+        half = omega * self.spec.track_width / 2
+        self._speeds = np.array([v - half, v + half]) / self.spec.wheel_radius
+
+    def targets(self, time: float) -> np.ndarray:
+        return self._speeds[self._sides]
+
+    def stop(self) -> None:
+        """Immediate stop (a dead robot's motors are unpowered, not ramped)."""
+        self.slew.reset()
+        self._speeds = np.zeros(2)
+
+
+class TricycleDrive:
+    """Front wheel steered to ``delta = atan(omega L / v)`` and driven at ``v / cos(delta)`` so the rear-axle
+    midpoint moves at (v, omega) (bicycle model, wheelbase ``L``). The steering angle changes no faster than
+    ``steer_rate_max``, and with v = 0 the robot cannot turn: it has no point turns (Chand §3.6)."""
+    continuous = False
+
+    def __init__(self, spec, limits, control_dt: float):
+        self.spec = spec
+        self.slew = SlewLimiter(limits, control_dt)
+        self.dt = control_dt
+        self.steer = 0.0
+        self.wheel_speed = 0.0
+
+    def command(self, v: float, omega: float) -> None:
+        v, omega = self.slew(v, omega)
+        spec = self.spec
+        if abs(v) > 1e-3:
+            wanted = math.atan(omega * spec.wheelbase / v)
+        else:
+            wanted = self.steer  # standing still: keep the wheel where it is
+        wanted = min(max(wanted, -spec.steer_max), spec.steer_max)
+        step = spec.steer_rate_max * self.dt
+        self.steer += min(max(wanted - self.steer, -step), step)
+        self.wheel_speed = v / max(math.cos(self.steer), 0.05) / spec.wheel_radius
+
+    def targets(self, time: float) -> np.ndarray:
+        return np.array([self.steer, self.wheel_speed])
+
+    def stop(self) -> None:
+        self.slew.reset()
+        self.wheel_speed = 0.0
+
+
+LOCOMOTION_FOR_SPEC: dict[type, type] = {
+    DifferentialSpec: DifferentialDrive,
+    TricycleSpec: TricycleDrive,
+}
+
+
+def make_locomotion(spec, limits, control_dt: float):
+    """The locomotion controller for a robot's drive spec."""
+    return LOCOMOTION_FOR_SPEC[type(spec)](spec, limits, control_dt)

@@ -21,6 +21,27 @@ class Box:
     yaw: float = 0.0
 
 
+@dataclass(frozen=True)
+class Bog:
+    """Boggy ground (Chand ch.6-8): an axis-aligned zone, centre (x, y) and half sizes. It is drawn here and
+    resists motion physically in the world (see ``teamsim.world``), in proportion to each robot's
+    traversability."""
+    x: float
+    y: float
+    half_x: float
+    half_y: float
+
+    def contains(self, x, y):
+        return (abs(x - self.x) <= self.half_x) & (abs(y - self.y) <= self.half_y)
+
+
+def add_bog(arena: mjcf.RootElement, bog: Bog, name: str) -> None:
+    """Draw the bog as a thin brown patch that nothing collides with."""
+    arena.worldbody.add("geom", name=name, type="box", pos=[bog.x, bog.y, 0.001],
+                        size=[bog.half_x, bog.half_y, 0.001], rgba=[0.35, 0.25, 0.12, 0.9],
+                        contype=0, conaffinity=0)
+
+
 def walled_room(size_x: float, size_y: float, *, wall_height: float = 0.5, wall_thickness: float = 0.1,
                 obstacles: tuple[Box, ...] = (), physics_dt: float = 0.002, name: str = "arena",
                 camera_fovy: float = 45.0, aspect: float = 4 / 3) -> mjcf.RootElement:

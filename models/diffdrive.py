@@ -12,7 +12,8 @@ from dataclasses import dataclass
 from dm_control import mjcf
 
 from teamsim.models.ir import IRModel
-from teamsim.models.robot import DriveLimits, RobotModel, add_ir_ring, add_tracking_camera, colour_of
+from teamsim.models.robot import (DifferentialSpec, DriveLimits, RobotModel, add_ir_ring, add_tracking_camera,
+                                  colour_of)
 
 
 @dataclass(frozen=True)
@@ -20,6 +21,7 @@ class DiffDriveDims:
     radius: float = 0.35  # Table 3.1 (0.40 in ch.5, Table 5.22)
     ir_count: int = 10  # Table 3.1
     ir_range: float = 1.5  # Table 3.1
+    traversability: float = 0.1  # Table 5.22 (Robots 3, 5-7)
     v_max: float = 0.5  # Table 3.1
     omega_max: float = math.pi / 7  # Table 3.1
     # Chand gives acceleration limits only for Scratchy (Table 3.4); we apply them to this robot too.
@@ -66,7 +68,6 @@ def build(name: str, dims: DiffDriveDims = DiffDriveDims()) -> RobotModel:
         chassis.add("geom", name=f"caster_{side}", type="sphere", size=[dims.caster_radius],
                     pos=[x * (dims.radius - 0.08), 0, dims.caster_radius + dims.caster_gap], condim=1, mass=0.1,
                     rgba=[0.2, 0.2, 0.2, 1])
-    motors = []
     for side, y in (("left", 1), ("right", -1)):
         wheel = chassis.add("body", name=f"{side}_wheel", pos=[0, y * dims.track_width / 2, dims.wheel_radius])
         wheel.add("joint", name=side, type="hinge", axis=[0, 1, 0], damping=0.05)
@@ -75,11 +76,11 @@ def build(name: str, dims: DiffDriveDims = DiffDriveDims()) -> RobotModel:
         model.actuator.add("velocity", name=side, joint=side, kv=dims.wheel_servo_gain,
                            forcerange=[-dims.wheel_torque, dims.wheel_torque], forcelimited=True,
                            ctrlrange=[-dims.v_max / dims.wheel_radius * 1.5, dims.v_max / dims.wheel_radius * 1.5])
-        motors.append(side)
     ir_names, bearings = add_ir_ring(chassis, dims.ir_count, dims.radius + 0.005, dims.ir_height, dims.ir_range)
     camera = add_tracking_camera(chassis, distance=2.0)
     limits = DriveLimits(dims.v_max, dims.omega_max, dims.accel_max, dims.angular_accel_max)
+    drive = DifferentialSpec(dims.wheel_radius, dims.track_width, left=("left",), right=("right",))
     return RobotModel(kind="diffdrive", name=name, mjcf=model, root_body="chassis", ir_sensors=ir_names,
-                      ir_bearings=bearings, ir=IRModel.for_range(dims.ir_range), motors=tuple(motors),
-                      wheel_radius=dims.wheel_radius, track_width=dims.track_width, limits=limits,
-                      footprint_radius=dims.radius, tracking_camera=camera)
+                      ir_bearings=bearings, ir=IRModel.for_range(dims.ir_range), drive=drive, limits=limits,
+                      footprint_radius=dims.radius, tracking_camera=camera,
+                      max_traction=2 * dims.wheel_torque / dims.wheel_radius, traversability=dims.traversability)

@@ -6,7 +6,7 @@ they are prefixed with the robot's name (``red/left``), which is the robot's MJC
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 from dm_control import mjcf
@@ -49,6 +49,49 @@ class DriveLimits:
 
 
 @dataclass(frozen=True)
+class DifferentialSpec:
+    """Wheels on two sides, every actuator of a side driven at that side's speed (skid-steer tracks too).
+
+    Actuators are velocity servos on wheel hinges whose positive rotation drives the robot forward."""
+    wheel_radius: float
+    track_width: float
+    left: tuple[str, ...]
+    right: tuple[str, ...]
+
+    @property
+    def actuators(self) -> tuple[str, ...]:
+        return self.left + self.right
+
+
+@dataclass(frozen=True)
+class TricycleSpec:
+    """A front wheel that both steers and drives, ``wheelbase`` ahead of the passive rear axle (whose
+    midpoint is the robot's reference point). ``steer`` is a position servo, ``drive`` a velocity servo."""
+    wheel_radius: float
+    wheelbase: float
+    steer: str
+    drive: str
+    steer_max: float  # rad
+    steer_rate_max: float  # rad/s
+
+    @property
+    def actuators(self) -> tuple[str, ...]:
+        return (self.steer, self.drive)
+
+
+@dataclass(frozen=True)
+class Effector:
+    """An actuated extra (a gripper's jaws, its lift) commanded in [0, 1] through ``Command.extras[name]``.
+
+    0 and 1 map linearly to the actuators' set-points ``ctrl_at_0`` and ``ctrl_at_1``; the robot feels the
+    effector's position, normalised the same way, from ``joint``'s encoder."""
+    actuators: tuple[str, ...]
+    joint: str
+    ctrl_at_0: float
+    ctrl_at_1: float
+
+
+@dataclass(frozen=True)
 class RobotModel:
     kind: str
     name: str
@@ -57,12 +100,22 @@ class RobotModel:
     ir_sensors: tuple[str, ...]
     ir_bearings: np.ndarray  # bearing of each IR sensor in the body frame, rad, same order as ir_sensors
     ir: IRModel
-    motors: tuple[str, ...]  # locomotion actuators, in the order the locomotion controller fills them
-    wheel_radius: float
-    track_width: float
+    drive: object  # DifferentialSpec, TricycleSpec, or a legged robot's gait spec (has .actuators)
     limits: DriveLimits
     footprint_radius: float
     tracking_camera: str
+    max_traction: float  # N the locomotion can push with at full effort (calibrates bog drag)
+    traversability: float = 1.0  # Chand Table 5.22: share of its speed kept on difficult terrain
+    effectors: dict = field(default_factory=dict)  # name -> Effector
+    touch: dict = field(default_factory=dict)  # name -> geom names whose contact normal forces it sums, N
+    beams: tuple[str, ...] = ()  # rangefinders across a gap: "broken" when they read less than beam_length
+    beam_length: float = 0.0
+    inclinometer: bool = False
+
+    @property
+    def motors(self) -> tuple[str, ...]:
+        """Locomotion actuators, in the order the locomotion controller fills them."""
+        return tuple(self.drive.actuators)
 
 
 def add_ir_ring(body: mjcf.Element, count: int, radius: float, height: float, max_range: float,

@@ -3,7 +3,7 @@ trial is over and whether it succeeded, and measures it.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any, ClassVar, Protocol
 
 import numpy as np
@@ -28,6 +28,7 @@ class RobotSlot:
 class Scene:
     arena: mjcf.RootElement
     robots: list[RobotSlot]
+    bogs: list = field(default_factory=list)  # teamsim.models.arenas.Bog zones, already drawn in the arena
 
 
 class Mission(Protocol):

@@ -21,7 +21,7 @@ import numpy as np
 
 from teamsim.config import ConfigError, TrialConfig
 from teamsim.controllers.base import Command, Observation
-from teamsim.controllers.locomotion import DifferentialDrive
+from teamsim.controllers.locomotion import make_locomotion
 from teamsim.faults import Fault, Health, apply_fault
 from teamsim.models import ROBOT_BUILDERS, build_robot
 from teamsim.models.robot import RobotModel
@@ -46,7 +46,7 @@ class Robot:
     """One robot in the world: its model, controller, health and bookkeeping."""
     model: RobotModel
     controller: object
-    drive: DifferentialDrive
+    drive: object  # the locomotion controller (teamsim.controllers.locomotion)
     ir_rng: np.random.Generator
     dormant: bool
     spawn: tuple[float, float, float]
@@ -59,8 +59,10 @@ class Robot:
     qvel_adr: int = 0
     ir_adr: np.ndarray = None
     actuators: np.ndarray = None
-    wheel_dofs: np.ndarray = None
+    motor_dofs: np.ndarray = None
     geoms: np.ndarray = None
+    beam_adr: np.ndarray = None
+    effectors: dict = field(default_factory=dict)  # name -> (actuator ids, joint qpos address)
 
     @property
     def name(self) -> str:
@@ -69,6 +71,14 @@ class Robot:
     @property
     def active(self) -> bool:
         return self.health.alive and not self.dormant
+
+
+def bog_drag(robot: RobotModel) -> float:
+    """Viscous drag coefficient (N s/m) of a bog on ``robot``, chosen so that at full effort its locomotion
+    holds a speed of ``traversability x v_max`` there. Chand (Table 5.22) scores traversability in [0, 1] with
+    tracked robots at 1.0 (they cross bogs at full speed) and wheeled ones at 0.1-0.3; the thesis gives no
+    physical model, so this one makes a robot's top speed in a bog proportional to its traversability."""
+    return robot.max_traction / (max(robot.traversability, 1e-3) * robot.limits.v_max)
 
 
 def yaw_of(quat: np.ndarray) -> float:
@@ -106,9 +116,10 @@ class World:
             self.robots[slot.name] = Robot(
                 model=model,
                 controller=mission.controller(model, config.params, self.streams.get("robot", slot.name, "brain")),
-                drive=DifferentialDrive(model.wheel_radius, model.track_width, model.limits, self.control_dt),
+                drive=make_locomotion(model.drive, model.limits, self.control_dt),
                 ir_rng=self.streams.get("robot", slot.name, "ir"), dormant=slot.dormant,
                 spawn=(slot.x, slot.y, slot.yaw))
+        self.bogs = list(scene.bogs)
         self.check_faults(config.faults)
         self.faults = sorted(config.faults, key=lambda f: f.time)
         self.xml = scene.arena.to_xml_string()
@@ -136,35 +147,52 @@ class World:
                 raise ConfigError(f"{spec}: no robot {fault.robot!r}; team: {', '.join(self.robots)}")
             if fault.kind == "break-motor" and fault.options.get("motor") not in (None, *robot.model.motors):
                 raise ConfigError(f"{spec}: motor must be one of {', '.join(robot.model.motors)}")
-            if fault.kind == "break-gripper":
+            if fault.kind == "break-gripper" and not robot.model.effectors:
                 raise ConfigError(f"{spec}: a {robot.model.kind} robot has no gripper")
 
     def _index_model(self) -> None:
         m = self.model
-        robot_of_actuator = []
+
+        def ids(kind, names, prefix):
+            return np.array([mujoco.mj_name2id(m, kind, f"{prefix}/{n}") for n in names], dtype=int)
+
+        owner_of_actuator = np.full(m.nu, -1)
+        self._geom_owner = np.full(m.ngeom, -1)
+        self._touch_of_geom = np.full(m.ngeom, -1)  # geom -> index into self._touch_names
+        self._touch_names: list[tuple[int, str]] = []  # (robot index, touch sensor name)
         for k, robot in enumerate(self.robots.values()):
-            name = robot.name
+            name, spec = robot.name, robot.model
             root = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, f"{name}/")
             joint = m.body_jntadr[root]
             robot.qpos_adr, robot.qvel_adr = int(m.jnt_qposadr[joint]), int(m.jnt_dofadr[joint])
-            robot.ir_adr = np.array([m.sensor_adr[mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_SENSOR, f"{name}/{s}")]
-                                     for s in robot.model.ir_sensors])
-            robot.actuators = np.array([mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_ACTUATOR, f"{name}/{a}")
-                                        for a in robot.model.motors])
-            robot.wheel_dofs = m.jnt_dofadr[m.actuator_trnid[robot.actuators, 0]]
+            robot.ir_adr = m.sensor_adr[ids(mujoco.mjtObj.mjOBJ_SENSOR, spec.ir_sensors, name)]
+            robot.beam_adr = m.sensor_adr[ids(mujoco.mjtObj.mjOBJ_SENSOR, spec.beams, name)]
+            robot.actuators = ids(mujoco.mjtObj.mjOBJ_ACTUATOR, spec.motors, name)
+            robot.motor_dofs = m.jnt_dofadr[m.actuator_trnid[robot.actuators, 0]]
+            for effector_name, effector in spec.effectors.items():
+                joint_id = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, f"{name}/{effector.joint}")
+                robot.effectors[effector_name] = (ids(mujoco.mjtObj.mjOBJ_ACTUATOR, effector.actuators, name),
+                                                  int(m.jnt_qposadr[joint_id]))
+            owner_of_actuator[[a for a in range(m.nu) if m.actuator(a).name.startswith(f"{name}/")]] = k
             bodies = [b for b in range(m.nbody) if m.body(b).name.startswith(f"{name}/")]
             robot.geoms = np.flatnonzero(np.isin(m.geom_bodyid, bodies))
-            robot_of_actuator += [k] * len(robot.actuators)
-        self._actuator_owner = np.array(robot_of_actuator, dtype=int)
-        self._all_actuators = np.concatenate([r.actuators for r in self.robots.values()])
-        self._geom_owner = np.full(m.ngeom, -1)
-        for k, robot in enumerate(self.robots.values()):
             self._geom_owner[robot.geoms] = k
+            for touch_name, geom_names in spec.touch.items():
+                self._touch_of_geom[ids(mujoco.mjtObj.mjOBJ_GEOM, geom_names, name)] = len(self._touch_names)
+                self._touch_names.append((k, touch_name))
+        self._all_actuators = np.flatnonzero(owner_of_actuator >= 0)
+        self._actuator_owner = owner_of_actuator[self._all_actuators]
+        self._continuous = [r for r in self.robots.values() if r.drive.continuous]
         self._is_floor = m.geom_type == mujoco.mjtGeom.mjGEOM_PLANE
         self._touching_s = np.zeros(len(self.robots))
         self._names = list(self.robots)
+        self._index_of = {name: k for k, name in enumerate(self._names)}
         self._root_dofs = np.array([r.qvel_adr for r in self.robots.values()])
         self._actuator_energy_j = np.zeros(len(self._all_actuators))
+        self._root_qpos = np.array([r.qpos_adr for r in self.robots.values()])
+        self._bog_drag = np.array([bog_drag(r.model) for r in self.robots.values()])
+        # Turning in a bog drags the footprint's rim: rotational damping = drag x (radius^2 / 2).
+        self._yaw_arm2 = np.array([r.model.footprint_radius ** 2 / 2 for r in self.robots.values()])
         self.odometry_m = np.zeros(len(self.robots))
 
     # -- state ----------------------------------------------------------------------------------------------
@@ -209,8 +237,9 @@ class World:
             self.record({"t": round(now, 6), "event": "radio", "robot": message.sender, "payload": message.payload})
         for k in self._robots_touching():
             self._touching_s[k] += self.control_dt
+        touch = self._touch_forces()
         for robot, (raw, ranges) in zip(live, self._read_ir(live)):
-            self._control(robot, now, raw, ranges)
+            self._control(robot, now, raw, ranges, touch[self._index_of[robot.name]])
 
     def _read_ir(self, robots: list[Robot]) -> list[tuple[np.ndarray, np.ndarray]]:
         """(raw, range) IR readings per robot, one vectorised IR-model call per sensor model."""
@@ -230,15 +259,21 @@ class World:
                 readings[k] = (raw[lo:hi], ranges[lo:hi])
         return readings
 
-    def _control(self, robot: Robot, now: float, ir_raw: np.ndarray, ir_range: np.ndarray) -> None:
-        d = self.data
+    def _control(self, robot: Robot, now: float, ir_raw: np.ndarray, ir_range: np.ndarray, touch: dict) -> None:
+        d, spec = self.data, robot.model
+        beams = d.sensordata[robot.beam_adr]
         observation = Observation(
             time=now, robot=robot.name, ir_raw=ir_raw, ir_range=ir_range,
-            ir_bearings=robot.model.ir_bearings, pose=self.positioning.fix(robot.name),
+            ir_bearings=spec.ir_bearings, pose=self.positioning.fix(robot.name),
             inbox=tuple(self.radio.take_inbox(robot.name)),
             robots_present=self.radio.robots_present(robot.name, now),
-            wheel_speeds=d.qvel[robot.wheel_dofs])
+            motor_speeds=d.qvel[robot.motor_dofs], touch=touch,
+            break_beams=(beams >= 0) & (beams < spec.beam_length),
+            inclination=self.inclination(robot) if spec.inclinometer else None,
+            effectors={name: self._effector_position(robot, name) for name in robot.effectors})
         command: Command = robot.controller(observation)
+        if not (math.isfinite(command.v) and math.isfinite(command.omega)):
+            raise ValueError(f"controller of {robot.name} returned a non-finite command {command}")
         if command.behaviour != robot.behaviour:
             self.record({"t": round(now, 6), "event": "behaviour", "robot": robot.name,
                          "from": robot.behaviour, "to": command.behaviour})
@@ -248,7 +283,51 @@ class World:
             self.radio.set_outbox(robot.name, command.broadcast)
         if command.v or command.omega:
             robot.parker_energy += self.control_dt
-        d.ctrl[robot.actuators] = robot.drive.wheel_speeds(command.v, command.omega) * robot.health.speed_factor
+        factor = robot.health.speed_factor
+        robot.drive.command(command.v * factor, command.omega * factor)
+        d.ctrl[robot.actuators] = robot.drive.targets(now)
+        for name, setpoint in command.extras.items():
+            self._set_effector(robot, name, setpoint)
+
+    def _set_effector(self, robot: Robot, name: str, setpoint: float) -> None:
+        if name not in robot.effectors:
+            raise ValueError(f"{robot.name} ({robot.model.kind}) has no effector {name!r}; "
+                             f"it has: {', '.join(robot.effectors) or 'none'}")
+        effector = robot.model.effectors[name]
+        setpoint = min(max(float(setpoint), 0.0), 1.0)
+        self.data.ctrl[robot.effectors[name][0]] = effector.ctrl_at_0 + setpoint * (effector.ctrl_at_1 - effector.ctrl_at_0)
+
+    def _effector_position(self, robot: Robot, name: str) -> float:
+        """The effector's encoder reading, on the same [0, 1] scale as its command."""
+        effector = robot.model.effectors[name]
+        q = self.data.qpos[robot.effectors[name][1]]
+        return float((q - effector.ctrl_at_0) / (effector.ctrl_at_1 - effector.ctrl_at_0))
+
+    def inclination(self, robot: Robot) -> tuple[float, float]:
+        """(roll, pitch) of the robot's body, rad: what an inclinometer on its chassis reads."""
+        w, x, y, z = self.data.qpos[robot.qpos_adr + 3:robot.qpos_adr + 7]
+        roll = math.atan2(2 * (w * x + y * z), 1 - 2 * (x * x + y * y))
+        pitch = math.asin(max(-1.0, min(1.0, 2 * (w * y - z * x))))
+        return roll, pitch
+
+    def _touch_forces(self) -> list[dict]:
+        """Per robot, each touch sensor's summed normal force from contacts with anything but itself, N."""
+        readings = [{name: 0.0 for name in r.model.touch} for r in self.robots.values()]
+        d = self.data
+        if not self._touch_names or d.ncon == 0:
+            return readings
+        pairs = d.contact.geom[: d.ncon]
+        sensors = self._touch_of_geom[pairs]
+        owners = self._geom_owner[pairs]
+        candidates = np.flatnonzero((sensors >= 0).any(axis=1) & (owners[:, 0] != owners[:, 1]))
+        wrench = np.zeros(6)
+        for i in candidates:
+            mujoco.mj_contactForce(self.model, d, int(i), wrench)
+            for sensor in sensors[i]:
+                if sensor >= 0:
+                    robot_index, name = self._touch_names[sensor]
+                    readings[robot_index][name] += abs(wrench[0])
+        return readings
 
     def _robots_touching(self) -> np.ndarray:
         """Indices of robots in contact with anything but the floor (walls, obstacles, other robots)."""
@@ -268,17 +347,22 @@ class World:
         else:
             apply_fault(fault, robot.health, robot.model.motors)
             if fault.kind == "break-motor":
-                self._unpower(robot, fault.options.get("motor") or robot.model.motors[0])
+                motor = fault.options.get("motor") or robot.model.motors[0]
+                self._unpower(robot.actuators[robot.model.motors.index(motor)])
+            if fault.kind == "break-gripper":
+                for actuators, _ in robot.effectors.values():
+                    self._unpower(*actuators)
             if not robot.health.alive:
-                self.data.ctrl[robot.actuators] = robot.drive.stop()
+                robot.drive.stop()
+                self.data.ctrl[robot.actuators] = robot.drive.targets(now)
         self.radio.set_enabled(robot.name, robot.health.radio_on and not robot.dormant)
         self.record({"t": round(now, 6), "event": "fault", **fault.describe()})
 
-    def _unpower(self, robot: Robot, motor: str) -> None:
-        """A broken motor freewheels: its actuator no longer produces force."""
-        actuator = robot.actuators[robot.model.motors.index(motor)]
-        self.model.actuator_gainprm[actuator, :] = 0
-        self.model.actuator_biasprm[actuator, :] = 0
+    def _unpower(self, *actuators: int) -> None:
+        """A broken motor goes limp: its actuator no longer produces force."""
+        for actuator in actuators:
+            self.model.actuator_gainprm[actuator, :] = 0
+            self.model.actuator_biasprm[actuator, :] = 0
 
     def _place(self, robot: Robot) -> None:
         """Bring a dormant robot into the arena at its reserved spawn pose (the add-robot fault)."""
@@ -296,9 +380,29 @@ class World:
         end = self.step + steps
         while self.step < end:
             chunk = min(self.steps_per_energy - self.step % self.steps_per_energy, end - self.step)
+            for robot in self._continuous:  # gaits: set-points move within the control period
+                if robot.active:
+                    d.ctrl[robot.actuators] = robot.drive.targets(self.time)
+            if self.bogs:
+                self._apply_bog_drag()
             mujoco.mj_step(m, d, nstep=chunk)
             self.step += chunk
             self._sample_power(chunk * self.physics_dt)
+
+    def _apply_bog_drag(self) -> None:
+        """Viscous drag on the horizontal motion of robots inside a bog, as damping on their free joint.
+
+        MuJoCo integrates joint damping implicitly, so even the stiff drag of a bog on a poorly
+        traversable robot stays stable at the physics timestep. Membership is re-checked every
+        ``energy_dt``."""
+        x, y = self.data.qpos[self._root_qpos], self.data.qpos[self._root_qpos + 1]
+        inside = np.zeros(len(x), bool)
+        for bog in self.bogs:
+            inside |= bog.contains(x, y)
+        drag = np.where(inside, self._bog_drag, 0.0)
+        for axis in (0, 1):
+            self.model.dof_damping[self._root_dofs + axis] = drag
+        self.model.dof_damping[self._root_dofs + 5] = drag * self._yaw_arm2
 
     def _sample_power(self, dt: float) -> None:
         """Integrate |force x velocity| of every actuator, and odometry, over the last ``dt`` seconds."""

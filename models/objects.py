@@ -1,0 +1,60 @@
+"""Mission objects: Parker's pucks and the long heavy box, as free bodies to attach into an arena.
+
+Static walls and obstacles are part of the arena (``teamsim.models.arenas``).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from dm_control import mjcf
+
+INCH = 0.0254
+
+
+@dataclass(frozen=True)
+class PuckDims:
+    """Parker §3.8: the spill is cylinders 2 in in diameter and 1.5 in high. Mass and friction are assumed
+    (a solid plastic cylinder of that size is about 0.08 kg)."""
+    radius: float = 1.0 * INCH
+    height: float = 1.5 * INCH
+    mass: float = 0.08
+    friction: float = 0.8
+
+
+@dataclass(frozen=True)
+class BoxDims:
+    """Parker §6.1: a long, heavy box that one robot pushing at its middle cannot move. The thesis gives no
+    size or mass; these are assumed so that one R-2 (about 90 N of traction) cannot slide it (static friction
+    0.6 x 30 kg x 9.81 = 177 N) but can turn it about its far end by pushing one end."""
+    length: float = 1.5
+    depth: float = 0.3
+    height: float = 0.3
+    mass: float = 30.0
+    friction: float = 0.6
+
+
+def puck(name: str, dims: PuckDims = PuckDims(), rgba=(0.95, 0.75, 0.1, 1)) -> mjcf.RootElement:
+    model = mjcf.RootElement(model=name)
+    body = model.worldbody.add("body", name="puck")
+    body.add("geom", name="shell", type="cylinder", size=[dims.radius, dims.height / 2],
+             pos=[0, 0, dims.height / 2], mass=dims.mass, rgba=rgba, friction=[dims.friction, 0.005, 0.0001],
+             condim=4)
+    return model
+
+
+def box(name: str, dims: BoxDims = BoxDims(), rgba=(0.6, 0.45, 0.3, 1)) -> mjcf.RootElement:
+    model = mjcf.RootElement(model=name)
+    body = model.worldbody.add("body", name="box")
+    body.add("geom", name="shell", type="box", size=[dims.depth / 2, dims.length / 2, dims.height / 2],
+             pos=[0, 0, dims.height / 2], mass=dims.mass, rgba=rgba, friction=[dims.friction, 0.005, 0.0001])
+    return model
+
+
+def place(arena: mjcf.RootElement, thing: mjcf.RootElement, x: float, y: float, yaw: float = 0.0,
+          z: float = 0.0) -> mjcf.Element:
+    """Attach a free object into the arena at (x, y, z) with heading ``yaw``."""
+    frame = arena.attach(thing)
+    frame.add("freejoint")
+    frame.pos = [x, y, z]
+    frame.euler = [0, 0, yaw]
+    return frame
