@@ -8,11 +8,10 @@ period.
 """
 from __future__ import annotations
 
+import importlib
 import math
 
 import numpy as np
-
-from teamsim.models.robot import DifferentialSpec, TricycleSpec
 
 
 class SlewLimiter:
@@ -95,12 +94,14 @@ class TricycleDrive:
         self.wheel_speed = 0.0
 
 
-LOCOMOTION_FOR_SPEC: dict[type, type] = {
-    DifferentialSpec: DifferentialDrive,
-    TricycleSpec: TricycleDrive,
+LOCOMOTION_FOR_SPEC: dict[str, str] = {
+    "DifferentialSpec": "teamsim.controllers.locomotion:DifferentialDrive",
+    "TricycleSpec": "teamsim.controllers.locomotion:TricycleDrive",
+    "GaitSpec": "teamsim.controllers.gait:TripodGait",  # legged robots (Genghis-II)
 }
 
 
 def make_locomotion(spec, limits, control_dt: float):
-    """The locomotion controller for a robot's drive spec."""
-    return LOCOMOTION_FOR_SPEC[type(spec)](spec, limits, control_dt)
+    """The locomotion controller for a robot's drive spec, looked up by the spec's class name."""
+    module, _, cls = LOCOMOTION_FOR_SPEC[type(spec).__name__].partition(":")
+    return getattr(importlib.import_module(module), cls)(spec, limits, control_dt)

@@ -4,21 +4,30 @@ This package imports nothing else of teamsim's.
 """
 from __future__ import annotations
 
-from collections.abc import Callable
+import importlib
 
-from teamsim.models import diffdrive
 from teamsim.models.robot import RobotModel
 
-# Every robot kind teamsim knows by name. Builders exist for those in ROBOT_BUILDERS; the others are
-# reserved names for the kinds still to come (r2 and genghis2 from Parker, tricycle and tracked from Chand).
+# Every robot kind teamsim knows by name, and the module whose ``build(name)`` makes it.
 ROBOT_KINDS = ("r2", "genghis2", "tricycle", "diffdrive", "tracked")
-ROBOT_BUILDERS: dict[str, Callable[[str], RobotModel]] = {
-    "diffdrive": diffdrive.build,
-}
+_MODULES = {kind: f"teamsim.models.{kind}" for kind in ROBOT_KINDS}
+
+
+def _available() -> dict:
+    builders = {}
+    for kind, module in _MODULES.items():
+        try:
+            builders[kind] = importlib.import_module(module).build
+        except ModuleNotFoundError as exc:
+            if exc.name != module:
+                raise
+    return builders
+
+
+ROBOT_BUILDERS = _available()
 
 
 def build_robot(kind: str, name: str) -> RobotModel:
     if kind not in ROBOT_BUILDERS:
-        built = ", ".join(ROBOT_BUILDERS)
-        raise ValueError(f"robot kind {kind!r} is not available; available: {built}")
+        raise ValueError(f"robot kind {kind!r} is not available; available: {', '.join(ROBOT_BUILDERS)}")
     return ROBOT_BUILDERS[kind](name)
