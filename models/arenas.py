@@ -47,6 +47,7 @@ def walled_room(size_x: float, size_y: float, *, wall_height: float = 0.5, wall_
                 camera_fovy: float = 45.0, aspect: float = 4 / 3) -> mjcf.RootElement:
     """A rectangular room centred on the origin, with static box obstacles and a top-down camera ``top``."""
     arena = mjcf.RootElement(model=name)
+    arena.compiler.angle = "radian"  # every angle teamsim writes (joint ranges, euler) is in radians
     arena.option.timestep = physics_dt
     arena.option.integrator = "implicitfast"
     arena.visual.headlight.ambient = [0.35, 0.35, 0.35]  # light the walls' sides, not just their tops

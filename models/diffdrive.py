@@ -7,11 +7,12 @@ not in the thesis and is assumed below, in one place.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 from dm_control import mjcf
 
 from teamsim.models.ir import IRModel
+from teamsim.models.parts import add_caster, add_livery, add_velocity_motor, add_wheel
 from teamsim.models.robot import (DifferentialSpec, DriveLimits, RobotModel, add_ir_ring, add_tracking_camera,
                                   colour_of)
 
@@ -47,35 +48,24 @@ class DiffDriveDims:
         return 2 * (self.radius - self.wheel_inset)
 
 
-def build(name: str, dims: DiffDriveDims = DiffDriveDims()) -> RobotModel:
+def build(name: str, **overrides) -> RobotModel:
+    """The robot called ``name``; ``overrides`` replace DiffDriveDims fields (e.g. radius=0.40)."""
+    dims = replace(DiffDriveDims(), **overrides)
     model = mjcf.RootElement(model=name)
-    rgba = colour_of(name)
     chassis = model.worldbody.add("body", name="chassis")
     body_half = (dims.height - dims.ground_clearance) / 2
     chassis.add("geom", name="shell", type="cylinder", size=[dims.radius, body_half],
                 pos=[0, 0, dims.ground_clearance + body_half], mass=dims.mass, rgba=[0.35, 0.35, 0.38, 1])
-    chassis.add("geom", name="lid", type="cylinder", size=[dims.radius * 0.9, 0.005],
-                pos=[0, 0, dims.height + 0.005], rgba=rgba, contype=0, conaffinity=0, mass=0.01)
-    chassis.add("geom", name="nose", type="box", size=[dims.radius * 0.2, 0.04, 0.006],
-                pos=[dims.radius * 0.7, 0, dims.height + 0.012], rgba=[1, 1, 1, 1],
-                contype=0, conaffinity=0, mass=0.01)
+    add_livery(chassis, colour_of(name), dims.height, dims.radius * 0.9)
     chassis.add("geom", name="battery", type="box", size=[0.06, 0.1, 0.05], mass=dims.battery_mass,
                 pos=[dims.battery_x, 0, dims.ground_clearance + 0.06], contype=0, conaffinity=0, group=3)
-    # Frictionless ball casters fore and aft: a caster with lateral friction stops a diff-drive turning
-    # (maxspahn/gym_envs_urdf#140), so they carry normal load only (condim 1). They sit a few mm high: four
-    # rigid supports share the weight arbitrarily, and wheels left with little load slip.
     for side, x in (("front", 1), ("back", -1)):
-        chassis.add("geom", name=f"caster_{side}", type="sphere", size=[dims.caster_radius],
-                    pos=[x * (dims.radius - 0.08), 0, dims.caster_radius + dims.caster_gap], condim=1, mass=0.1,
-                    rgba=[0.2, 0.2, 0.2, 1])
+        add_caster(chassis, side, x * (dims.radius - 0.08), dims.caster_radius, dims.caster_gap)
+    max_wheel_speed = 1.5 * dims.v_max / dims.wheel_radius
     for side, y in (("left", 1), ("right", -1)):
-        wheel = chassis.add("body", name=f"{side}_wheel", pos=[0, y * dims.track_width / 2, dims.wheel_radius])
-        wheel.add("joint", name=side, type="hinge", axis=[0, 1, 0], damping=0.05)
-        wheel.add("geom", name=f"{side}_tyre", type="cylinder", size=[dims.wheel_radius, dims.wheel_width / 2],
-                  zaxis=[0, 1, 0], mass=0.5, friction=[1.2, 0.01, 0.001], rgba=[0.1, 0.1, 0.1, 1])
-        model.actuator.add("velocity", name=side, joint=side, kv=dims.wheel_servo_gain,
-                           forcerange=[-dims.wheel_torque, dims.wheel_torque], forcelimited=True,
-                           ctrlrange=[-dims.v_max / dims.wheel_radius * 1.5, dims.v_max / dims.wheel_radius * 1.5])
+        add_wheel(chassis, side, [0, y * dims.track_width / 2, dims.wheel_radius], dims.wheel_radius,
+                  dims.wheel_width, mass=0.5)
+        add_velocity_motor(model, side, dims.wheel_servo_gain, dims.wheel_torque, max_wheel_speed)
     ir_names, bearings = add_ir_ring(chassis, dims.ir_count, dims.radius + 0.005, dims.ir_height, dims.ir_range)
     camera = add_tracking_camera(chassis, distance=2.0)
     limits = DriveLimits(dims.v_max, dims.omega_max, dims.accel_max, dims.angular_accel_max)

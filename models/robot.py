@@ -6,6 +6,7 @@ they are prefixed with the robot's name (``red/left``), which is the robot's MJC
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -118,15 +119,40 @@ class RobotModel:
         return tuple(self.drive.actuators)
 
 
-def add_ir_ring(body: mjcf.Element, count: int, radius: float, height: float, max_range: float,
-                first_bearing: float = 0.0) -> tuple[tuple[str, ...], np.ndarray]:
-    """Rangefinder sites evenly spaced over 360 degrees, looking outward from ``radius`` at ``height``."""
+def polygon_rim(vertices: list[tuple[float, float]]) -> Callable[[float], float]:
+    """Distance from the origin to the edge of a convex polygon (around the origin) along a bearing."""
+    edges = list(zip(vertices, vertices[1:] + vertices[:1]))
+
+    def rim(bearing: float) -> float:
+        c, s = math.cos(bearing), math.sin(bearing)
+        hits = []
+        for (x1, y1), (x2, y2) in edges:
+            ex, ey = x2 - x1, y2 - y1
+            denom = c * ey - s * ex
+            if abs(denom) < 1e-12:
+                continue
+            t = (x1 * ey - y1 * ex) / denom  # distance along the ray
+            u = (x1 * s - y1 * c) / denom  # position along the edge
+            if t > 0 and -1e-9 <= u <= 1 + 1e-9:
+                hits.append(t)
+        return min(hits)
+    return rim
+
+
+def add_ir_ring(body: mjcf.Element, count: int, radius: float | Callable[[float], float], height: float,
+                max_range: float, first_bearing: float = 0.0,
+                centre: tuple[float, float] = (0.0, 0.0)) -> tuple[tuple[str, ...], np.ndarray]:
+    """Rangefinder sites evenly spaced over 360 degrees at ``height``, looking outward from the body's rim.
+
+    ``radius`` is the rim's distance from ``centre``: a number for a round body, or a function of bearing
+    (see :func:`polygon_rim`) for any other outline."""
     root = body.root
     names, bearings = [], []
     for k in range(count):
         bearing = first_bearing + 2 * math.pi * k / count
         c, s = math.cos(bearing), math.sin(bearing)
-        site = body.add("site", name=f"ir{k}", pos=[radius * c, radius * s, height], size=[0.01],
+        r = radius(bearing) if callable(radius) else radius
+        site = body.add("site", name=f"ir{k}", pos=[centre[0] + r * c, centre[1] + r * s, height], size=[0.01],
                         zaxis=[c, s, 0], rgba=[1, 0.3, 0.3, 0.6], group=3)
         root.sensor.add("rangefinder", name=f"ir{k}", site=site, cutoff=max_range)
         names.append(f"ir{k}")

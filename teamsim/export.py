@@ -14,6 +14,7 @@ def robot_on_floor(kind: str) -> mjcf.RootElement:
     if kind not in ROBOT_BUILDERS:
         raise ConfigError(f"unknown robot {kind!r}; available: {', '.join(ROBOT_BUILDERS)}")
     scene = mjcf.RootElement(model=f"{kind}_on_floor")
+    scene.compiler.angle = "radian"  # robot builders write angles in radians
     scene.option.integrator = "implicitfast"
     scene.worldbody.add("light", pos=[0, 0, 4], dir=[0, 0, -1], directional=True)
     scene.worldbody.add("geom", name="floor", type="plane", size=[5, 5, 0.1], rgba=[0.8, 0.8, 0.78, 1])
