@@ -11,7 +11,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from conftest import wander_config
+from tests.helpers import wander_config
 
 from teamsim import recording
 from teamsim.faults import parse_fault

@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import imageio_ffmpeg
 import numpy as np
-from conftest import wander_config
+from tests.helpers import wander_config
 
 from teamsim.cli import main
 from teamsim.runner import run_trial

@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from conftest import ScriptedMission, advance_seconds, wander_config
+from tests.helpers import ScriptedMission, advance_seconds, wander_config
 
 from teamsim.config import ConfigError
 from teamsim.faults import parse_fault

@@ -1,4 +1,7 @@
-"""Harness for contact-behaviour regression tests: a scripted scene stepped through the full World."""
+"""Harness for contact-behaviour regression tests: a scripted scene stepped through the full World.
+
+Import it as ``from tests.contact.harness import make_world, run_for, ...`` (tests is a package).
+"""
 from __future__ import annotations
 
 import numpy as np
