@@ -4,7 +4,8 @@ Every drive first clips the command to the robot's speed limits and slews it by 
 one control period, as Chand's dynamic window assumes (eq. 3.11-3.12). ``command`` is called once per control
 tick; ``targets(t)`` gives the actuator set-points, in the order of the drive spec's ``actuators``. A drive
 whose set-points change between ticks (a gait) sets ``continuous``, and the world asks it again during the
-period.
+period. A drive may define ``feedback(yaw_rate)``: the world then gives it the robot's gyro reading (rad/s)
+before each ``command``.
 """
 from __future__ import annotations
 
@@ -38,7 +39,12 @@ class SlewLimiter:
 
 class DifferentialDrive:
     """``w_left = (v - omega b/2) / r``, ``w_right = (v + omega b/2) / r`` for track ``b``, wheel radius ``r``;
-    every actuator of a side gets its side's speed (the co-driven rollers of a skid-steer track too)."""
+    every actuator of a side gets its side's speed (the co-driven rollers of a skid-steer track too).
+
+    Skid steering turns much slower than this kinematic model says, because the track ends scrub sideways.
+    With ``spec.yaw_rate_gain`` > 0 the drive adds an integral correction from the gyro's yaw rate to the
+    turn it asks of the tracks, as a tracked robot's low-level controller does; the correction is bounded to
+    four times the robot's turn-rate limit and bleeds away while the robot is asked not to turn."""
     continuous = False
 
     def __init__(self, spec, limits, control_dt: float):
@@ -46,10 +52,20 @@ class DifferentialDrive:
         self.slew = SlewLimiter(limits, control_dt)
         self._sides = np.array([0] * len(spec.left) + [1] * len(spec.right))
         self._speeds = np.zeros(2)
+        self._yaw_rate = 0.0
+        self._correction = 0.0
+
+    def feedback(self, yaw_rate: float) -> None:
+        self._yaw_rate = yaw_rate
 
     def command(self, v: float, omega: float) -> None:
         v, omega = self.slew(v, omega)
-        half = omega * self.spec.track_width / 2
+        gain = self.spec.yaw_rate_gain
+        if gain:
+            bound = 4 * self.slew.limits.omega_max
+            self._correction += gain * (omega - self._yaw_rate) * self.slew.dt
+            self._correction = min(max(self._correction, -bound), bound)
+        half = (omega + self._correction) * self.spec.track_width / 2
         self._speeds = np.array([v - half, v + half]) / self.spec.wheel_radius
 
     def targets(self, time: float) -> np.ndarray:
@@ -59,6 +75,7 @@ class DifferentialDrive:
         """Immediate stop (a dead robot's motors are unpowered, not ramped)."""
         self.slew.reset()
         self._speeds = np.zeros(2)
+        self._correction = 0.0
 
 
 class TricycleDrive:

@@ -8,13 +8,13 @@ TYRE_RGBA = (0.1, 0.1, 0.1, 1)
 
 
 def add_wheel(parent: mjcf.Element, name: str, pos, radius: float, width: float, mass: float,
-              damping: float = 0.05) -> mjcf.Element:
+              damping: float = 0.05, friction: tuple = TYRE_FRICTION) -> mjcf.Element:
     """A cylinder wheel on a hinge about the parent's y axis; the hinge joint is called ``name``.
     Positive rotation rolls the parent forward (+x)."""
     wheel = parent.add("body", name=f"{name}_wheel", pos=list(pos))
     joint = wheel.add("joint", name=name, type="hinge", axis=[0, 1, 0], damping=damping)
     wheel.add("geom", name=f"{name}_tyre", type="cylinder", size=[radius, width / 2], zaxis=[0, 1, 0],
-              mass=mass, friction=list(TYRE_FRICTION), rgba=list(TYRE_RGBA))
+              mass=mass, friction=list(friction), rgba=list(TYRE_RGBA))
     return joint
 
 

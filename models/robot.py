@@ -58,6 +58,9 @@ class DifferentialSpec:
     track_width: float
     left: tuple[str, ...]
     right: tuple[str, ...]
+    # Skid steering slips: a robot that skids (tracks) closes a loop on its gyro's yaw rate, with this
+    # integral gain (1/s). 0 for wheels that roll without scrubbing.
+    yaw_rate_gain: float = 0.0
 
     @property
     def actuators(self) -> tuple[str, ...]:

@@ -284,6 +284,8 @@ class World:
         if command.v or command.omega:
             robot.parker_energy += self.control_dt
         factor = robot.health.speed_factor
+        if hasattr(robot.drive, "feedback"):
+            robot.drive.feedback(self.yaw_rate(robot))
         robot.drive.command(command.v * factor, command.omega * factor)
         d.ctrl[robot.actuators] = robot.drive.targets(now)
         for name, setpoint in command.extras.items():
@@ -302,6 +304,11 @@ class World:
         effector = robot.model.effectors[name]
         q = self.data.qpos[robot.effectors[name][1]]
         return float((q - effector.ctrl_at_0) / (effector.ctrl_at_1 - effector.ctrl_at_0))
+
+    def yaw_rate(self, robot: Robot) -> float:
+        """What a gyro on the chassis reads about its vertical axis, rad/s (free-joint angular velocity is in
+        the body frame)."""
+        return float(self.data.qvel[robot.qvel_adr + 5])
 
     def inclination(self, robot: Robot) -> tuple[float, float]:
         """(roll, pitch) of the robot's body, rad: what an inclinometer on its chassis reads."""
