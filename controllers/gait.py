@@ -36,7 +36,7 @@ class TripodGait:
 
     def command(self, v: float, omega: float) -> None:
         v, omega = self.slew(v, omega)
-        foot_speed = v - omega * self._foot_y
+        foot_speed = v - self.spec.turn_gain * omega * self._foot_y
         peak = float(np.abs(foot_speed).max())
         if peak > self.spec.foot_speed_max:
             foot_speed = foot_speed * (self.spec.foot_speed_max / peak)

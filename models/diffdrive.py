@@ -12,7 +12,7 @@ from dataclasses import dataclass, replace
 from dm_control import mjcf
 
 from teamsim.models.ir import IRModel
-from teamsim.models.parts import add_caster, add_livery, add_velocity_motor, add_wheel
+from teamsim.models.parts import TYRE_FRICTION, add_caster, add_livery, add_velocity_motor, add_wheel, max_traction
 from teamsim.models.robot import (DifferentialSpec, DriveLimits, RobotModel, add_ir_ring, add_tracking_camera,
                                   colour_of)
 
@@ -73,4 +73,6 @@ def build(name: str, **overrides) -> RobotModel:
     return RobotModel(kind="diffdrive", name=name, mjcf=model, root_body="chassis", ir_sensors=ir_names,
                       ir_bearings=bearings, ir=IRModel.for_range(dims.ir_range), drive=drive, limits=limits,
                       footprint_radius=dims.radius, tracking_camera=camera,
-                      max_traction=2 * dims.wheel_torque / dims.wheel_radius, traversability=dims.traversability)
+                      max_traction=max_traction(2 * dims.wheel_torque / dims.wheel_radius,
+                                                dims.mass + dims.battery_mass, TYRE_FRICTION[0]),
+                      traversability=dims.traversability)

@@ -44,6 +44,7 @@ class GaitSpec:
     lift_stance: float  # rad, lift set-point of a foot on the ground
     lift_swing: float  # rad, lift set-point at the top of a step
     frequency: float  # Hz, step cycles per second (one stance and one swing per leg)
+    turn_gain: float  # stride per unit of turn rate, relative to the no-slip ideal (front and rear feet slip)
 
     @property
     def actuators(self) -> tuple[str, ...]:
@@ -97,9 +98,13 @@ class Genghis2Dims:
     frequency: float = 0.8
     swing_max: float = 0.3
     lift_swing: float = 0.3
+    # Turning, a two-DOF leg moves its foot only fore and aft, so the front and rear feet slip sideways and a
+    # tripod stepping the ideal differential stride turns at only about 60 % of the rate (measured here on the
+    # 1.0-1.2 friction floor). The gait steps 1/0.6 times harder to turn at the commanded rate.
+    turn_gain: float = 1.0 / 0.6
     # Assumed command limits, well below the R-2's 0.457 m/s (§2.2.1): Genghis-II is the slower robot (§6.1.1).
     v_max: float = 0.08
-    omega_max: float = 0.5
+    omega_max: float = 0.4  # rad/s; turning on the spot at this rate uses nearly the whole stride
     accel_max: float = 0.2
     angular_accel_max: float = 1.0
     # Assumed sensors: four 0.3 m near-IR rangers at the shoulder corners, the front pair looking 30 degrees
@@ -212,7 +217,7 @@ def build(name: str, dims: Genghis2Dims = Genghis2Dims()) -> RobotModel:
     gait = GaitSpec(legs=LEGS, phase_offset=TRIPOD_PHASE,
                     foot_y=tuple(s * dims.width / 2 for _, s in (layout[leg] for leg in LEGS)),
                     reach=dims.reach, swing_max=dims.swing_max, lift_stance=0.0, lift_swing=dims.lift_swing,
-                    frequency=dims.frequency)
+                    frequency=dims.frequency, turn_gain=dims.turn_gain)
     if dims.v_max > gait.foot_speed_max:
         raise ValueError(f"v_max {dims.v_max} m/s exceeds what the gait can step ({gait.foot_speed_max:.3f} m/s)")
     limits = DriveLimits(dims.v_max, dims.omega_max, dims.accel_max, dims.angular_accel_max)

@@ -40,3 +40,12 @@ def add_livery(body: mjcf.Element, rgba, top: float, radius: float, centre_x: fl
              rgba=list(rgba), contype=0, conaffinity=0, mass=0.01)
     body.add("geom", name="nose", type="box", size=[radius * 0.25, 0.04, 0.006],
              pos=[centre_x + radius * 0.75, 0, top + 0.012], rgba=[1, 1, 1, 1], contype=0, conaffinity=0, mass=0.01)
+
+
+GRAVITY = 9.81
+
+
+def max_traction(motor_force: float, driven_load_kg: float, friction: float) -> float:
+    """The horizontal force (N) a robot can push with at full effort: its motors' force at the ground,
+    unless the driven wheels slip first (friction x weight they carry)."""
+    return min(motor_force, friction * driven_load_kg * GRAVITY)

@@ -15,7 +15,7 @@ from dataclasses import dataclass, replace
 from dm_control import mjcf
 
 from teamsim.models.ir import IRModel
-from teamsim.models.parts import add_livery, add_velocity_motor, add_wheel
+from teamsim.models.parts import add_livery, add_velocity_motor, add_wheel, max_traction
 from teamsim.models.robot import (DifferentialSpec, DriveLimits, RobotModel, add_ir_ring, add_tracking_camera,
                                   colour_of, polygon_rim)
 
@@ -91,5 +91,6 @@ def build(name: str, **overrides) -> RobotModel:
     return RobotModel(kind="tracked", name=name, mjcf=model, root_body="chassis", ir_sensors=ir_names,
                       ir_bearings=bearings, ir=IRModel.for_range(dims.ir_range), drive=drive, limits=limits,
                       footprint_radius=dims.radius, tracking_camera=add_tracking_camera(chassis, distance=2.8),
-                      max_traction=2 * dims.rollers_per_side * dims.roller_torque / dims.roller_radius,
+                      max_traction=max_traction(2 * dims.rollers_per_side * dims.roller_torque / dims.roller_radius,
+                                                dims.mass, dims.roller_friction),
                       traversability=dims.traversability)

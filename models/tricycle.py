@@ -17,7 +17,7 @@ from dataclasses import dataclass, replace
 from dm_control import mjcf
 
 from teamsim.models.ir import IRModel
-from teamsim.models.parts import add_livery, add_velocity_motor, add_wheel
+from teamsim.models.parts import TYRE_FRICTION, add_livery, add_velocity_motor, add_wheel, max_traction
 from teamsim.models.robot import (DriveLimits, RobotModel, TricycleSpec, add_ir_ring, add_tracking_camera,
                                   colour_of, polygon_rim)
 
@@ -40,6 +40,7 @@ class TricycleDims:
     height: float = 0.45
     ground_clearance: float = 0.06
     mass: float = 20.0
+    front_load: float = 0.33  # share of the weight on the driven front wheel (body centred on the wheelbase)
     drive_torque: float = 12.0  # N m at the front wheel
     drive_servo_gain: float = 40.0
     steer_max: float = math.radians(60)
@@ -90,4 +91,6 @@ def build(name: str, **overrides) -> RobotModel:
     return RobotModel(kind="tricycle", name=name, mjcf=model, root_body="chassis", ir_sensors=ir_names,
                       ir_bearings=bearings, ir=IRModel.for_range(dims.ir_range), drive=drive, limits=limits,
                       footprint_radius=dims.radius, tracking_camera=add_tracking_camera(chassis, distance=2.5),
-                      max_traction=dims.drive_torque / dims.wheel_radius, traversability=dims.traversability)
+                      max_traction=max_traction(dims.drive_torque / dims.wheel_radius, dims.mass * dims.front_load,
+                                                TYRE_FRICTION[0]),
+                      traversability=dims.traversability)

@@ -1,0 +1,155 @@
+"""Contact regression: the wheeled robots drive, turn, stop, sense and idle as the theses' numbers say.
+
+Each robot runs through the full World (locomotion with its acceleration limits, physics contacts, IR model)
+with a scripted (v, omega). Tolerances are the issue's: heading drift < 3 % over 2 m, circle radius error
+< 5 %, stopping within v^2 / 2a.
+"""
+from __future__ import annotations
+
+import math
+
+import mujoco
+import numpy as np
+import pytest
+
+from teamsim.faults import parse_fault
+from teamsim.models.arenas import Bog, Box
+from tests.contact.harness import CustomParams, RobotSlot, make_world, run_for
+
+WHEELED = ("diffdrive", "tricycle", "tracked")
+
+
+def solo(kind: str, policy, room=(16.0, 16.0), x=-5.0, y=0.0, yaw=0.0, **params):
+    world = make_world(CustomParams(room=room, robots=[RobotSlot("red", kind, x, y, yaw)], **params),
+                       {"red": policy})
+    return world, world.robots["red"]
+
+
+def unstable_warnings(world) -> list[str]:
+    return [mujoco.mjtWarning(k).name for k, n in enumerate(world.data.warning.number) if n]
+
+
+@pytest.mark.parametrize("kind", WHEELED)
+def test_drives_two_metres_straight(kind):
+    world, red = solo(kind, lambda o: (0.25, 0.0))
+    start = world.pose(red)
+    run_for(world, 30.0, until=lambda w: w.pose(red)[0] - start[0] >= 2.0)
+    end = world.pose(red)
+    travelled = end[0] - start[0]
+    assert travelled >= 2.0
+    assert abs(end[1] - start[1]) / travelled < 0.03, "lateral drift"
+    assert abs(end[2] - start[2]) < 0.03, "heading drift (rad)"
+
+
+@pytest.mark.parametrize("kind", WHEELED)
+def test_follows_a_circle(kind):
+    v, omega = 0.3, 0.15
+    world, red = solo(kind, lambda o: (v, omega), x=0.0, y=-2.0)
+    run_for(world, 8.0)  # past the acceleration ramp
+    points = []
+    for _ in range(40):  # about one full circle (2 pi / 0.15 = 42 s)
+        run_for(world, 1.0)
+        points.append(world.pose(red)[:2])
+    points = np.array(points)
+    a = np.c_[2 * points, np.ones(len(points))]
+    cx, cy, k = np.linalg.lstsq(a, (points ** 2).sum(axis=1), rcond=None)[0]
+    radius = math.sqrt(k + cx ** 2 + cy ** 2)
+    assert radius == pytest.approx(v / omega, rel=0.05)
+
+
+@pytest.mark.parametrize("kind", WHEELED)
+def test_stops_within_its_deceleration_distance(kind):
+    cruise = 0.3
+    commands = {"v": cruise}
+    world, red = solo(kind, lambda o: (commands["v"], 0.0))
+    run_for(world, 8.0)
+    speed = world.speed(red)
+    assert speed == pytest.approx(cruise, rel=0.05)
+    start = world.pose(red)[:2]
+    commands["v"] = 0.0
+    run_for(world, 6.0)
+    stopped = float(np.hypot(*(world.pose(red)[:2] - start)))
+    limit = speed ** 2 / (2 * red.model.limits.accel_max)
+    assert world.speed(red) < 0.01
+    # One control period of reaction at cruise speed on top of the braking distance.
+    assert stopped <= limit + speed * world.control_dt + 0.02
+
+
+@pytest.mark.parametrize("kind", WHEELED)
+def test_idle_is_stable(kind):
+    world, red = solo(kind, lambda o: (0.0, 0.0))
+    run_for(world, 0.5)  # settle onto the floor
+    start = world.data.qpos[red.qpos_adr:red.qpos_adr + 3].copy()
+    run_for(world, 10.0)
+    assert unstable_warnings(world) == []
+    assert np.abs(world.data.qpos[red.qpos_adr:red.qpos_adr + 3] - start).max() < 1e-3
+
+
+@pytest.mark.parametrize("kind", WHEELED)
+def test_ir_reads_a_wall_within_the_noise_model(kind):
+    """Facing a wall at several distances, the front sensor's raw readings stay within 4 sigma of the
+    calibration's response (sigma = noise fraction x response, plus quantisation)."""
+    for gap in (0.3, 0.6, 1.0, 1.3):
+        room = 8.0
+        world, red = solo(kind, lambda o: (0.0, 0.0), room=(room, room), x=0.0)
+        ir = red.model.ir
+        front = int(np.argmin(np.abs(red.model.ir_bearings)))
+        mujoco.mj_kinematics(world.model, world.data)
+        site = mujoco.mj_name2id(world.model, mujoco.mjtObj.mjOBJ_SITE, f"red/{red.model.ir_sensors[front]}")
+        reach = world.data.site_xpos[site][0]  # sensor's distance ahead of the robot's frame
+        world.data.qpos[red.qpos_adr] = room / 2 - gap - reach
+        run_for(world, 3.0)
+        raws = np.array([o.ir_raw[front] for o in world.controllers["red"].observations[5:]])
+        clean = float(ir.response(gap))
+        sigma = float(np.interp(gap, ir.distances, ir.noise_fractions)) * clean + ir.resolution
+        assert np.all(np.abs(raws - clean) <= 4 * sigma), (kind, gap, raws.min(), raws.max(), clean)
+        assert np.median(world.controllers["red"].observations[-1].ir_range[front]) == pytest.approx(gap, abs=0.15)
+
+
+def test_blinded_sensors_read_nothing():
+    world = make_world(CustomParams(room=(4.0, 4.0), robots=[RobotSlot("red", "diffdrive", 1.0, 0.0, 0.0)]),
+                       {"red": lambda o: (0.0, 0.0)}, faults=[parse_fault("blind-ir:red@1")])
+    run_for(world, 2.0)
+    observations = world.controllers["red"].observations
+    assert (observations[5].ir_raw > 0).any(), "the wall 0.65 m ahead is seen before the fault"
+    assert all((o.ir_raw == 0).all() and np.isinf(o.ir_range).all() for o in observations if o.time >= 1.0)
+
+
+def test_tricycle_cannot_turn_in_place():
+    world, red = solo("tricycle", lambda o: (0.0, 0.4))
+    start = world.pose(red)
+    run_for(world, 6.0)
+    end = world.pose(red)
+    assert abs(end[2] - start[2]) < 0.02
+    assert np.hypot(*(end[:2] - start[:2])) < 0.01
+
+
+def test_tricycle_reverses_out_of_a_dead_end():
+    """A corridor 1.4 m wide, closed ahead: the tricycle (1 m across) cannot turn round in it, so it backs out."""
+    walls = (Box(0.0, 0.95, 2.0, 0.1), Box(0.0, -0.95, 2.0, 0.1), Box(2.1, 0.0, 0.1, 1.05))
+    commands = {"v": 0.2}
+    world, red = solo("tricycle", lambda o: (commands["v"], 0.0), x=-1.0, obstacles=walls)
+    run_for(world, 20.0, until=lambda w: w.pose(red)[0] > 1.0)  # drive in until the end wall is near
+    ahead = world.controllers["red"].observations[-1]
+    assert np.min(ahead.ir_range[np.abs(ahead.ir_bearings) < 0.3]) < 1.0, "it sees the dead end"
+    commands["v"] = -0.2
+    run_for(world, 30.0, until=lambda w: w.pose(red)[0] < -2.5)
+    x, y, yaw = world.pose(red)
+    assert x < -2.5, "out of the corridor, whose mouth is at x = -2"
+    assert abs(y) < 0.2 and abs(yaw) < 0.1
+
+
+def test_bog_stops_wheels_but_not_tracks():
+    """A bog from x = -4 to 4: a differential robot of traversability 0.1 advances less than 30 % of its
+    commanded distance in it; a tracked robot (traversability 1.0) crosses it."""
+    bog = Bog(0.0, 0.0, 4.0, 3.0)
+    cruise, seconds = 0.3, 12.0
+    world, red = solo("diffdrive", lambda o: (cruise, 0.0), x=-3.0, bogs=[bog])
+    run_for(world, seconds)
+    commanded = cruise * (seconds - cruise / red.model.limits.accel_max / 2)  # minus the ramp's shortfall
+    assert world.pose(red)[0] + 3.0 < 0.3 * commanded
+
+    world, red = solo("tracked", lambda o: (cruise, 0.0), x=-5.0, bogs=[bog])
+    run_for(world, 40.0, until=lambda w: w.pose(red)[0] > 4.0 + red.model.footprint_radius)
+    assert world.pose(red)[0] > 4.0 + red.model.footprint_radius, "the tracked robot is through the bog"
+    assert world.time < 1.25 * (9.0 + red.model.footprint_radius) / cruise
