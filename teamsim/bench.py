@@ -1,6 +1,7 @@
 """``teamsim bench physics`` and ``teamsim bench render``: figures measured in one run, printed with ratios.
 
-physics: for teams of N wandering diffdrive robots, the steps/s and real-time factor of
+physics: for teams of N wandering diffdrive robots, and for one robot of each kind alone, the steps/s and
+real-time factor of
   (a) bare ``mujoco.mj_step`` on the same compiled model, sensors off, one C call for all steps;
   (b) the full stack: faults, IR sensing through the IR model, positioning, radio, controllers, locomotion,
       energy sampling and trajectory recording;
@@ -37,7 +38,7 @@ def bare_steps_per_second(world: World, steps: int) -> float:
     model = mujoco.MjModel.from_xml_string(world.xml)
     model.opt.disableflags |= int(mujoco.mjtDisableBit.mjDSBL_SENSOR)
     data = mujoco.MjData(model)
-    data.ctrl[:] = 3.0  # rad/s on every wheel: all robots drive, as in the full stack
+    data.ctrl[:] = np.clip(3.0, model.actuator_ctrlrange[:, 0], model.actuator_ctrlrange[:, 1])  # all drive
     start = time.perf_counter()
     mujoco.mj_step(model, data, nstep=steps)
     return steps / (time.perf_counter() - start)
@@ -66,6 +67,28 @@ def physics(seconds: float = 20.0, sizes: tuple[int, ...] = TEAM_SIZES) -> list[
         rows.append(row)
         print(f"{n:>6} {bare:>17.0f} {row['bare_rtf']:>6.1f}x {stack:>18.0f} {row['stack_rtf']:>6.1f}x "
               f"{row['ratio']:>6.2f}", flush=True)
+    return rows
+
+
+def robot_kinds(seconds: float = 10.0) -> list[dict]:
+    """One scene per robot kind: the robot alone in a room driving a (0.2 m/s, 0.1 rad/s) circle."""
+    from teamsim.controllers.base import Command
+    from teamsim.models import ROBOT_BUILDERS
+    from teamsim.tasks.base import RobotSlot
+    from teamsim.tasks.custom import CustomMission, CustomParams, custom_config
+
+    print(f"bench physics: one robot per scene, driving a circle, {seconds:g} s simulated")
+    print(f"{'robot':>10} {'(a) bare steps/s':>17} {'(b) stack steps/s':>18} {'RTF':>7} {'b/a':>6}")
+    rows = []
+    for kind in ROBOT_BUILDERS:
+        mission = CustomMission(lambda robot, rng: lambda obs: Command(v=0.2, omega=0.1, behaviour="circle"))
+        params = CustomParams(room=(10.0, 10.0), robots=[RobotSlot("red", kind, 0.0, -2.0, 0.0)])
+        world = World(custom_config(params), mission)
+        bare = bare_steps_per_second(world, round(seconds / world.physics_dt))
+        stack = stack_steps_per_second(world, seconds)
+        rows.append({"robot": kind, "bare_steps_per_s": bare, "stack_steps_per_s": stack})
+        print(f"{kind:>10} {bare:>17.0f} {stack:>18.0f} {stack * world.physics_dt:>6.1f}x {stack / bare:>6.2f}",
+              flush=True)
     return rows
 
 

@@ -92,12 +92,19 @@ def cmd_list(_args) -> int:
 
     print("robots:")
     for kind in ROBOT_KINDS:
-        if kind in ROBOT_BUILDERS:
-            robot = build_robot(kind, "x")
-            print(f"  {kind:<10} {len(robot.ir_sensors)} IR ({robot.ir.max_range:g} m), "
-                  f"actuators: {', '.join(robot.motors)}; v<={robot.limits.v_max:g} m/s")
-        else:
+        if kind not in ROBOT_BUILDERS:
             print(f"  {kind:<10} (not built yet)")
+            continue
+        robot = build_robot(kind, "x")
+        sensors = [f"{len(robot.ir_sensors)} IR ({robot.ir.max_range:g} m)"]
+        sensors += [f"touch {name}" for name in robot.touch]
+        sensors += [f"{len(robot.beams)} break-beams"] if robot.beams else []
+        sensors += ["inclinometer"] if robot.inclinometer else []
+        print(f"  {kind:<10} {type(robot.drive).__name__.removesuffix('Spec').lower()} drive, "
+              f"v <= {robot.limits.v_max:g} m/s, traversability {robot.traversability:g}")
+        print(f"  {'':<10} sensors: {', '.join(sensors)}")
+        print(f"  {'':<10} actuators: {', '.join(robot.motors)}"
+              + "".join(f"; {name}: {', '.join(e.actuators)}" for name, e in robot.effectors.items()))
     print("missions:")
     for name, mission in MISSIONS.items():
         print(f"  {name:<10} {mission.summary}")
@@ -126,6 +133,8 @@ def cmd_bench(args) -> int:
 
     if args.what == "physics":
         bench.physics(seconds=args.seconds or 20.0)
+        print()
+        bench.robot_kinds(seconds=args.seconds or 10.0)
     else:
         bench.render(seconds=args.seconds or 4.0)
     return 0
