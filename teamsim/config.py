@@ -26,8 +26,10 @@ def setting(default: Any, *, lo: float | None = None, hi: float | None = None, c
 
 @dataclass
 class Timing:
-    physics_dt: float = setting(0.002, lo=1e-4, hi=0.02, meaning="physics timestep, s (stable wheel, gripper, leg contacts)")
-    control_dt: float = setting(0.1, lo=0.01, hi=1.0, meaning="sensing/control period, s (Chand's explorers ran at 10 Hz)")
+    physics_dt: float = setting(0.002, lo=1e-4, hi=0.02,
+                                meaning="physics timestep, s (stable wheel, gripper, leg contacts)")
+    control_dt: float = setting(0.1, lo=0.01, hi=1.0,
+                                meaning="sensing/control period, s (Chand's explorers ran at 10 Hz)")
     energy_dt: float = setting(0.01, lo=1e-4, hi=1.0, meaning="actuator power sampling period for energy, s")
 
 
@@ -75,7 +77,8 @@ class TrialConfig:
     mission: str
     params: Any
     seed: int = setting(0, lo=0, hi=2**63 - 1, meaning="trial seed; every random stream derives from it")
-    duration: float | None = setting(None, lo=0.0, open_lo=True, hi=1e7, meaning="simulated seconds (mission default if unset)")
+    duration: float | None = setting(None, lo=0.0, open_lo=True, hi=1e7,
+                                     meaning="simulated seconds (mission default if unset)")
     out: str = setting("renders", meaning="output root; a run writes OUT/<mission>/<run-id>/")
     run_id: str | None = setting(None, meaning="run folder name (default: seed and a timestamp)")
     timing: Timing = field(default_factory=Timing)

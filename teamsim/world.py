@@ -297,7 +297,8 @@ class World:
                              f"it has: {', '.join(robot.effectors) or 'none'}")
         effector = robot.model.effectors[name]
         setpoint = min(max(float(setpoint), 0.0), 1.0)
-        self.data.ctrl[robot.effectors[name][0]] = effector.ctrl_at_0 + setpoint * (effector.ctrl_at_1 - effector.ctrl_at_0)
+        span = effector.ctrl_at_1 - effector.ctrl_at_0
+        self.data.ctrl[robot.effectors[name][0]] = effector.ctrl_at_0 + setpoint * span
 
     def _effector_position(self, robot: Robot, name: str) -> float:
         """The effector's encoder reading, on the same [0, 1] scale as its command."""
