@@ -1,4 +1,4 @@
-"""``wander``: the smoke mission. N differential-drive robots wander with IR obstacle avoidance in a walled
+"""``wander``: the smoke mission. N robots (differential-drive by default) wander with IR obstacle avoidance in a walled
 room for a fixed time. It completes when the time runs out with the physics stable; it measures how far each
 robot went and how much of the time robots spent touching walls, obstacles or each other.
 """
@@ -10,24 +10,25 @@ from dataclasses import dataclass
 import numpy as np
 
 from teamsim.config import ConfigError, setting
-from teamsim.controllers.wander import WanderController
+from teamsim.controllers.wander import WanderController, WanderParams as BehaviourParams
+from teamsim.models import ROBOT_KINDS
 from teamsim.models.arenas import Box, walled_room
 from teamsim.models.robot import RobotModel, team_names
 from teamsim.tasks.base import RobotSlot, Scene
 
-CELL = 1.2  # m; spawn grid pitch, wide enough for a 0.35 m robot plus clearance
+CELL = 1.6  # m; spawn grid pitch, wide enough for the largest robot (0.6 m enclosing radius) plus clearance
 
 
 @dataclass
 class WanderParams:
-    robots: int = setting(3, lo=1, hi=200, meaning="number of diffdrive robots")
+    robots: int = setting(3, lo=1, hi=200, meaning="number of robots")
     room_size: float = setting(0.0, lo=0.0, hi=200.0,
-                               meaning="side of the square room, m (0: sized for the team, 3 m^2 per robot, >= 6 m)")
+                               meaning="side of the square room, m (0: sized for the team, 4 m^2 per robot, >= 6 m)")
     obstacles: int = setting(3, lo=0, hi=100, meaning="static box obstacles placed at random")
-    kind: str = setting("diffdrive", choices=("diffdrive",), meaning="robot kind of the team")
+    kind: str = setting("diffdrive", choices=ROBOT_KINDS, meaning="robot kind of the team")
 
     def side(self, team_size: int) -> float:
-        return self.room_size or max(6.0, math.sqrt(3.0 * team_size))
+        return self.room_size or max(6.0, math.sqrt(4.0 * team_size))
 
     def check(self) -> None:
         side = self.side(self.robots)
@@ -39,7 +40,7 @@ class WanderParams:
 
 class WanderMission:
     name = "wander"
-    summary = "N differential-drive robots wander with IR obstacle avoidance in a walled room"
+    summary = "N robots (differential-drive by default) wander with IR obstacle avoidance in a walled room"
     Params = WanderParams
     default_duration = 60.0
 
@@ -63,7 +64,9 @@ class WanderMission:
         return Scene(arena=arena, robots=slots)
 
     def controller(self, robot: RobotModel, params: WanderParams, rng: np.random.Generator):
-        return WanderController(robot.ir_bearings, rng)
+        limits = robot.limits
+        behaviour = BehaviourParams().for_robot(limits.v_max, limits.omega_max, robot.ir.max_range)
+        return WanderController(robot.ir_bearings, rng, behaviour)
 
     def done(self, world) -> bool:
         return False

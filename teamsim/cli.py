@@ -132,7 +132,7 @@ def cmd_bench(args) -> int:
     from teamsim import bench
 
     if args.what == "physics":
-        bench.physics(seconds=args.seconds or 20.0)
+        bench.physics(seconds=args.seconds or 10.0)
         print()
         bench.robot_kinds(seconds=args.seconds or 10.0)
     else:
