@@ -8,8 +8,10 @@ therefore assumed: a fixed step frequency, a 50 % duty cycle, a straight-line st
 Legs 1, 3, 5 (left front, left rear, right middle) are in stance while 2, 4, 6 swing, then they swap. A stance
 foot moves back relative to the body at the speed the body should move forward over it: for a body twist
 (v, omega) a foot at lateral offset ``y`` must move at ``v - omega y``, so turning is a difference in stride
-between the left and right legs, and with v = 0 the sides step in opposite directions (turning on the spot;
-the front and rear feet slip sideways a little, since a two-DOF leg cannot move its foot across). Stride, not
+between the left and right legs, and with v = 0 the sides step in opposite directions (turning on the spot).
+A two-DOF leg cannot move its foot sideways, so in a turn the front and rear feet slip and the body turns
+slower than that ideal; the spec's ``turn_gain`` (calibrated in simulation) scales the turning part of the
+stride up to make it good, giving ``v - turn_gain omega y``. Stride, not
 frequency, carries the command: ``stride = foot speed / (2 f)``, since each stance lasts half a cycle. When one
 leg would have to step beyond its swing range, every stride is scaled down together, which keeps the
 commanded path curvature. Phase is a function of simulated time only, so a run is deterministic. With no

@@ -75,25 +75,35 @@ class Genghis2Dims:
     whisker_reach: float = 0.04
     whisker_spread: float = 0.045  # m each whisker tip reaches sideways beyond its root
     whisker_radius: float = 0.003
+    whisker_root_y: float = 0.02  # m off the centre line, on the nose
     whisker_height: float = 0.11  # m above the floor: above a stepping foot, below a box or wall top
     hip_height: float = 0.12  # m above the floor when standing; the chassis is centred on it
     chassis_thickness: float = 0.05
     leg_spacing: float = 0.13  # m between neighbouring hips along the body
     foot_radius: float = 0.012
+    shank_radius: float = 0.006
+    swing_stop: float = 0.45  # rad either side of neutral: the swing joint's mechanical range
+    lift_stops: tuple[float, float] = (-0.3, 0.45)  # rad, the lift joint's range: limp legs stop the belly 3 cm up
     foot_friction: float = 1.2
     radio_radius: float = 0.03  # the radio positioning unit on top: a cylinder up to the standing height
     belly_pad: tuple[float, float, float] = (0.04, 0.025, 0.003)  # half sizes of each belly tactile pad
-    leg_mass: float = 0.05  # each leg (hip bracket plus leg)
+    belly_pad_inset: float = 0.01  # m from the chassis ends to the front and back pads
+    # Each leg: a hip bracket (servo horn), the shank and the foot.
+    leg_masses: tuple[float, float, float] = (0.01, 0.03, 0.01)
     radio_mass: float = 0.12
     whisker_mass: float = 0.005
     # Assumed servos: hobby-class position servos. Swing 0.3 N m (about 3 kg cm); lift 1.5 N m, since one leg
-    # of a tripod carries half the weight (7.4 N at a 0.1 m lever is 0.74 N m) and must also lift it.
+    # of a tripod carries half the weight (7.4 N at the 0.104 m reach is 0.77 N m) and must also lift it.
     swing_torque: float = 0.3
     lift_torque: float = 1.5
     swing_gain: float = 10.0  # N m/rad
     lift_gain: float = 30.0  # N m/rad
     joint_damping: float = 0.05  # N m s/rad
     joint_armature: float = 0.002  # kg m^2, the servo's reflected rotor inertia
+    # Mean horizontal push over a step cycle relative to the stance tripod's stall force (3 x swing_torque /
+    # reach = 8.7 N): a stance leg reaches stall only part-way through its stroke. Measured here: 5.4 N steady
+    # against the long heavy box. This sets max_traction, which calibrates bog drag.
+    push_efficiency: float = 0.6
     # Assumed gait (Parker gives none): tripod at 0.8 Hz, swing up to 0.3 rad, foot raised by 0.3 rad of lift.
     frequency: float = 0.8
     swing_max: float = 0.3
@@ -135,13 +145,24 @@ class Genghis2Dims:
 
     @property
     def chassis_mass(self) -> float:
-        return self.mass - 6 * self.leg_mass - self.radio_mass - 2 * self.whisker_mass
+        return self.mass - 6 * sum(self.leg_masses) - self.radio_mass - 2 * self.whisker_mass
 
 
 def _leg_layout(dims: Genghis2Dims) -> dict[str, tuple[float, int]]:
     """Leg name -> (hip x, side: +1 left, -1 right)."""
     x = {"f": dims.leg_spacing, "m": 0.0, "r": -dims.leg_spacing}
     return {leg: (x[leg[1]], 1 if leg[0] == "l" else -1) for leg in LEGS}
+
+
+def gait_spec(dims: Genghis2Dims = Genghis2Dims()) -> GaitSpec:
+    """The gait's view of the legs; refuses a speed limit the gait cannot step."""
+    layout = _leg_layout(dims)
+    gait = GaitSpec(legs=LEGS, phase_offset=TRIPOD_PHASE, foot_y=tuple(layout[leg][1] * dims.width / 2 for leg in LEGS),
+                    reach=dims.reach, swing_max=dims.swing_max, lift_stance=0.0, lift_swing=dims.lift_swing,
+                    frequency=dims.frequency, turn_gain=dims.turn_gain)
+    if dims.v_max > gait.foot_speed_max:
+        raise ValueError(f"v_max {dims.v_max} m/s exceeds what the gait can step ({gait.foot_speed_max:.3f} m/s)")
+    return gait
 
 
 def build(name: str, dims: Genghis2Dims = Genghis2Dims()) -> RobotModel:
@@ -156,43 +177,46 @@ def build(name: str, dims: Genghis2Dims = Genghis2Dims()) -> RobotModel:
     radio_half = (dims.height - top) / 2
     chassis.add("geom", name="radio", type="cylinder", size=[dims.radio_radius, radio_half],
                 pos=[0, 0, top + radio_half], mass=dims.radio_mass, rgba=rgba)
+    # A white mark on the front of the deck shows the heading in videos (visual only).
     chassis.add("geom", name="nose", type="box", size=[0.02, half_width * 0.6, 0.004],
-                pos=[half_length - 0.03, 0, top + 0.004], rgba=[1, 1, 1, 1], contype=0, conaffinity=0, mass=0.001)
+                pos=[half_length - 0.03, 0, top + 0.004], rgba=[1, 1, 1, 1], contype=0, conaffinity=0, mass=0)
 
     # Belly tactile pads under the chassis: contact-force sensors (touch entries of the same names).
     bottom = dims.hip_height - dims.chassis_thickness / 2
     pad = dims.belly_pad
     belly = {}
-    for part, x in (("front", half_length - pad[0] - 0.01), ("middle", 0.0), ("back", -half_length + pad[0] + 0.01)):
+    pad_x = half_length - pad[0] - dims.belly_pad_inset
+    for part, x in (("front", pad_x), ("middle", 0.0), ("back", -pad_x)):
         chassis.add("geom", name=f"belly_{part}", type="box", size=list(pad), pos=[x, 0, bottom - pad[2]],
-                    mass=0.001, rgba=[0.9, 0.6, 0.1, 1])
+                    mass=0, rgba=[0.9, 0.6, 0.1, 1])
         belly[f"belly_{part}"] = (f"belly_{part}",)
 
-    # Front whiskers: thin stiff rods from the nose corners, angled outward; their contact force is the reading.
+    # Front whiskers: thin stiff rods from the nose, angled outward; their contact force is the reading.
     whiskers = {}
     for side, s in (("left", 1), ("right", -1)):
-        root = [half_length, s * half_width * 0.7, dims.whisker_height]
-        tip = [half_length + dims.whisker_reach - dims.whisker_radius, s * (half_width * 0.7 + dims.whisker_spread),
+        root = [half_length, s * dims.whisker_root_y, dims.whisker_height]
+        tip = [half_length + dims.whisker_reach - dims.whisker_radius, s * (dims.whisker_root_y + dims.whisker_spread),
                dims.whisker_height]
         chassis.add("geom", name=f"whisker_{side}", type="capsule", fromto=root + tip, size=[dims.whisker_radius],
                     mass=dims.whisker_mass, rgba=[0.9, 0.9, 0.9, 1])
         whiskers[f"whisker_{side}"] = (f"whisker_{side}",)
 
     # Legs: swing hinge (vertical axis) -> lift hinge (long axis) -> straight leg and spherical foot.
+    bracket_mass, shank_mass, foot_mass = dims.leg_masses
     for leg, (x, s) in _leg_layout(dims).items():
         hip = chassis.add("body", name=f"hip_{leg}", pos=[x, s * dims.hip_y, dims.hip_height])
         hip.add("joint", name=f"swing_{leg}", type="hinge", axis=[0, 0, -s], damping=dims.joint_damping,
-                armature=dims.joint_armature, range=[-1.5 * dims.swing_max, 1.5 * dims.swing_max])
-        hip.add("geom", name=f"bracket_{leg}", type="sphere", size=[0.015], mass=0.2 * dims.leg_mass,
+                armature=dims.joint_armature, range=[-dims.swing_stop, dims.swing_stop])
+        hip.add("geom", name=f"bracket_{leg}", type="sphere", size=[dims.shank_radius * 2.5], mass=bracket_mass,
                 contype=0, conaffinity=0, rgba=[0.2, 0.2, 0.2, 1])
         thigh = hip.add("body", name=f"leg_{leg}")
         thigh.add("joint", name=f"lift_{leg}", type="hinge", axis=[s, 0, 0], damping=dims.joint_damping,
-                  armature=dims.joint_armature, range=[-0.3, 1.5 * dims.lift_swing])
+                  armature=dims.joint_armature, range=list(dims.lift_stops))
         foot = [0, s * dims.reach, -dims.foot_drop]
-        thigh.add("geom", name=f"shank_{leg}", type="capsule", fromto=[0, 0, 0] + foot, size=[0.006],
-                  mass=0.6 * dims.leg_mass, rgba=[0.25, 0.25, 0.25, 1])
+        thigh.add("geom", name=f"shank_{leg}", type="capsule", fromto=[0, 0, 0] + foot, size=[dims.shank_radius],
+                  mass=shank_mass, rgba=[0.25, 0.25, 0.25, 1])
         thigh.add("geom", name=f"foot_{leg}", type="sphere", pos=foot, size=[dims.foot_radius],
-                  mass=0.2 * dims.leg_mass, friction=[dims.foot_friction, 0.01, 0.001], rgba=[0.1, 0.1, 0.1, 1])
+                  mass=foot_mass, friction=[dims.foot_friction, 0.01, 0.001], rgba=[0.1, 0.1, 0.1, 1])
         # A leg's root sits inside the chassis edge: the two never collide (a leg's hinge is their only link).
         model.contact.add("exclude", body1=chassis, body2=thigh)
         for joint, gain, torque, low, high in (
@@ -213,18 +237,13 @@ def build(name: str, dims: Genghis2Dims = Genghis2Dims()) -> RobotModel:
         ir_names.append(f"ir{k}")
 
     camera = add_tracking_camera(chassis, distance=0.9)
-    layout = _leg_layout(dims)
-    gait = GaitSpec(legs=LEGS, phase_offset=TRIPOD_PHASE,
-                    foot_y=tuple(s * dims.width / 2 for _, s in (layout[leg] for leg in LEGS)),
-                    reach=dims.reach, swing_max=dims.swing_max, lift_stance=0.0, lift_swing=dims.lift_swing,
-                    frequency=dims.frequency, turn_gain=dims.turn_gain)
-    if dims.v_max > gait.foot_speed_max:
-        raise ValueError(f"v_max {dims.v_max} m/s exceeds what the gait can step ({gait.foot_speed_max:.3f} m/s)")
+    gait = gait_spec(dims)
     limits = DriveLimits(dims.v_max, dims.omega_max, dims.accel_max, dims.angular_accel_max)
-    # Horizontal push at full effort: the three stance legs' swing servos at stall, through the foot lever.
-    traction = 3 * dims.swing_torque / dims.reach
+    # Horizontal push at full effort: the three stance legs' swing servos through the foot lever, over a step.
+    traction = dims.push_efficiency * 3 * dims.swing_torque / dims.reach
     return RobotModel(kind="genghis2", name=name, mjcf=model, root_body="chassis", ir_sensors=tuple(ir_names),
                       ir_bearings=np.asarray(dims.ir_bearings), ir=IRModel.for_range(dims.ir_range), drive=gait,
+                      # The circle around the standing 0.41 x 0.28 m outline encloses every part.
                       limits=limits, footprint_radius=math.hypot(dims.length / 2, dims.width / 2),
                       tracking_camera=camera, max_traction=traction, traversability=dims.traversability,
                       touch={**whiskers, **belly}, inclinometer=True)

@@ -23,12 +23,14 @@ CELL = 1.6  # m; spawn grid pitch, wide enough for the largest robot (0.6 m encl
 class WanderParams:
     robots: int = setting(3, lo=1, hi=200, meaning="number of robots")
     room_size: float = setting(0.0, lo=0.0, hi=200.0,
-                               meaning="side of the square room, m (0: sized for the team, 4 m^2 per robot, >= 6 m)")
+                               meaning="side of the square room, m (0: sized for the team and obstacles, >= 6 m)")
     obstacles: int = setting(3, lo=0, hi=100, meaning="static box obstacles placed at random")
     kind: str = setting("diffdrive", choices=ROBOT_KINDS, meaning="robot kind of the team")
 
     def side(self, team_size: int) -> float:
-        return self.room_size or max(6.0, math.sqrt(4.0 * team_size))
+        """The room's side: as set, or enough spawn cells for the team and obstacles with a third spare."""
+        cells_per_row = math.ceil(math.sqrt(1.5 * (team_size + self.obstacles)))
+        return self.room_size or max(6.0, CELL * cells_per_row)
 
     def check(self) -> None:
         side = self.side(self.robots)
