@@ -24,13 +24,15 @@ class PuckDims:
 @dataclass(frozen=True)
 class BoxDims:
     """Parker §6.1: a long, heavy box that one robot pushing at its middle cannot move. The thesis gives no
-    size or mass; these are assumed so that one R-2 (about 90 N of traction) cannot slide it (static friction
-    0.6 x 30 kg x 9.81 = 177 N) but can turn it about its far end by pushing one end."""
+    size or mass; these are assumed so that one R-2 (31.5 N of traction) cannot slide it (friction
+    0.5 x 7.5 kg x 9.81 = 36.8 N) but can turn it by pushing one end. Its contact takes priority over the
+    floor's (so its own friction applies) and is hard: with default soft contact a push below the friction
+    limit made the box creep about 3 mm/s."""
     length: float = 1.5
     depth: float = 0.3
     height: float = 0.3
-    mass: float = 30.0
-    friction: float = 0.6
+    mass: float = 7.5
+    friction: float = 0.5
 
 
 def puck(name: str, dims: PuckDims = PuckDims(), rgba=(0.95, 0.75, 0.1, 1)) -> mjcf.RootElement:
@@ -38,7 +40,7 @@ def puck(name: str, dims: PuckDims = PuckDims(), rgba=(0.95, 0.75, 0.1, 1)) -> m
     body = model.worldbody.add("body", name="puck")
     body.add("geom", name="shell", type="cylinder", size=[dims.radius, dims.height / 2],
              pos=[0, 0, dims.height / 2], mass=dims.mass, rgba=rgba, friction=[dims.friction, 0.005, 0.0001],
-             condim=4)
+             condim=4)  # (against the floor, MuJoCo takes the larger friction: the floor's 1.0)
     return model
 
 
@@ -46,7 +48,8 @@ def box(name: str, dims: BoxDims = BoxDims(), rgba=(0.6, 0.45, 0.3, 1)) -> mjcf.
     model = mjcf.RootElement(model=name)
     body = model.worldbody.add("body", name="box")
     body.add("geom", name="shell", type="box", size=[dims.depth / 2, dims.length / 2, dims.height / 2],
-             pos=[0, 0, dims.height / 2], mass=dims.mass, rgba=rgba, friction=[dims.friction, 0.005, 0.0001])
+             pos=[0, 0, dims.height / 2], mass=dims.mass, rgba=rgba, friction=[dims.friction, 0.005, 0.0001],
+             priority=1, solref=[0.004, 1], solimp=[0.999, 0.9999, 0.001])
     return model
 
 

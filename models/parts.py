@@ -29,8 +29,10 @@ def add_caster(parent: mjcf.Element, name: str, x: float, radius: float, gap: fl
     """A frictionless ball caster (condim 1: normal load only). A caster with lateral friction stops a
     differential robot turning (maxspahn/gym_envs_urdf#140). It rides ``gap`` above the floor so the drive
     wheels carry the load: rigid supports share weight arbitrarily, and lightly loaded wheels slip."""
+    # Priority 1: MuJoCo gives a contact the larger condim of two equal-priority geoms, so against the floor's
+    # condim 3 the caster would drag with the floor's friction (measured 19 N on an R-2).
     parent.add("geom", name=f"caster_{name}", type="sphere", size=[radius], pos=[x, y, radius + gap], condim=1,
-               mass=0.1, rgba=[0.2, 0.2, 0.2, 1])
+               priority=1, mass=0.1, rgba=[0.2, 0.2, 0.2, 1])
 
 
 def add_livery(body: mjcf.Element, rgba, top: float, radius: float, centre_x: float = 0.0) -> None:
