@@ -27,7 +27,11 @@ def _available() -> dict:
 ROBOT_BUILDERS = _available()
 
 
-def build_robot(kind: str, name: str) -> RobotModel:
+def build_robot(kind: str, name: str, **options) -> RobotModel:
+    """Robot ``name`` of ``kind``; ``options`` override fields of the kind's dimensions (e.g. radius=0.40)."""
     if kind not in ROBOT_BUILDERS:
         raise ValueError(f"robot kind {kind!r} is not available; available: {', '.join(ROBOT_BUILDERS)}")
-    return ROBOT_BUILDERS[kind](name)
+    try:
+        return ROBOT_BUILDERS[kind](name, **options)
+    except TypeError as exc:
+        raise ValueError(f"robot {name!r} ({kind}): {exc}") from None

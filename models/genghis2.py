@@ -16,7 +16,7 @@ raises it. At zero angles every foot touches the floor and the robot stands at i
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 from dm_control import mjcf
@@ -165,7 +165,9 @@ def gait_spec(dims: Genghis2Dims = Genghis2Dims()) -> GaitSpec:
     return gait
 
 
-def build(name: str, dims: Genghis2Dims = Genghis2Dims()) -> RobotModel:
+def build(name: str, **overrides) -> RobotModel:
+    """The robot called ``name``; ``overrides`` replace Genghis2Dims fields."""
+    dims = replace(Genghis2Dims(), **overrides)
     model = mjcf.RootElement(model=name)
     rgba = colour_of(name)
     half_length, half_width = dims.chassis_length / 2, dims.hip_y

@@ -22,6 +22,7 @@ class RobotSlot:
     y: float
     yaw: float
     dormant: bool = False
+    options: dict = field(default_factory=dict)  # builder overrides of the kind's dimensions, e.g. radius=0.40
 
 
 @dataclass

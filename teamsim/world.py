@@ -107,7 +107,10 @@ class World:
             if slot.kind not in ROBOT_BUILDERS:
                 raise ConfigError(f"robot {slot.name!r}: kind {slot.kind!r} is not available; "
                                   f"available: {', '.join(ROBOT_BUILDERS)}")
-            model = build_robot(slot.kind, slot.name)
+            try:
+                model = build_robot(slot.kind, slot.name, **slot.options)
+            except ValueError as exc:
+                raise ConfigError(str(exc)) from None
             frame = scene.arena.attach(model.mjcf)
             frame.add("freejoint")
             x, y = (PARKING_X + 3.0 * len(self.robots), 0.0) if slot.dormant else (slot.x, slot.y)

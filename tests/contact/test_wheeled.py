@@ -153,3 +153,17 @@ def test_bog_stops_wheels_but_not_tracks():
     run_for(world, 40.0, until=lambda w: w.pose(red)[0] > 4.0 + red.model.footprint_radius)
     assert world.pose(red)[0] > 4.0 + red.model.footprint_radius, "the tracked robot is through the bog"
     assert world.time < 1.25 * (9.0 + red.model.footprint_radius) / cruise
+
+
+def test_diffdrive_radius_is_a_parameter():
+    """Chand's circular robot is 0.35 m in ch.3 and 0.40 m in ch.5: the body and its IR ring follow."""
+    world = make_world(CustomParams(room=(6.0, 6.0), robots=[
+        RobotSlot("red", "diffdrive", -1.0, 0.0, 0.0),
+        RobotSlot("green", "diffdrive", 1.0, 0.0, 0.0, options={"radius": 0.40})]),
+        {"red": lambda o: (0.0, 0.0), "green": lambda o: (0.0, 0.0)})
+    model = world.model
+    for name, radius in (("red", 0.35), ("green", 0.40)):
+        shell = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, f"{name}/shell")
+        assert model.geom_size[shell][0] == pytest.approx(radius)
+        site = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_SITE, f"{name}/ir0")
+        assert np.hypot(*model.site_pos[site][:2]) == pytest.approx(radius, abs=0.01)
