@@ -30,6 +30,8 @@ class Scene:
     arena: mjcf.RootElement
     robots: list[RobotSlot]
     bogs: list = field(default_factory=list)  # teamsim.models.arenas.Bog zones, already drawn in the arena
+    params: Any = None  # the mission parameters it was built from
+    info: dict = field(default_factory=dict)  # whatever else the mission needs later (goal, known map, ...)
 
 
 class Mission(Protocol):
@@ -42,8 +44,8 @@ class Mission(Protocol):
               physics_dt: float) -> Scene:
         """The arena and the team; ``newcomers`` are (name, kind) pairs that join later (add-robot faults)."""
 
-    def controller(self, robot: RobotModel, params: Any, rng: np.random.Generator) -> Controller:
-        """The controller that drives ``robot``."""
+    def controller(self, robot: RobotModel, scene: Scene, rng: np.random.Generator) -> Controller:
+        """The controller that drives ``robot`` in ``scene`` (whose ``params`` and ``info`` it may use)."""
 
     def done(self, world: Any) -> bool:
         """True when the mission has ended before its time limit."""

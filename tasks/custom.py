@@ -45,9 +45,9 @@ class CustomMission:
             place(arena, box(f"box{k}", params.box_dims), x, y, yaw)
         for k, bog in enumerate(params.bogs):
             add_bog(arena, bog, f"bog{k}")
-        return Scene(arena=arena, robots=list(params.robots), bogs=list(params.bogs))
+        return Scene(arena=arena, robots=list(params.robots), bogs=list(params.bogs), params=params)
 
-    def controller(self, robot, params, rng):
+    def controller(self, robot, scene, rng):
         return self.controller_for(robot, rng)
 
     def done(self, world) -> bool:

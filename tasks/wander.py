@@ -63,9 +63,9 @@ class WanderMission:
         slots = [RobotSlot(name, kind, x, y, float(rng.uniform(-math.pi, math.pi)), dormant=k >= len(team))
                  for k, ((name, kind), (x, y)) in enumerate(zip(team + newcomers, chosen[params.obstacles:]))]
         arena = walled_room(side, side, obstacles=obstacles, physics_dt=physics_dt)
-        return Scene(arena=arena, robots=slots)
+        return Scene(arena=arena, robots=slots, params=params)
 
-    def controller(self, robot: RobotModel, params: WanderParams, rng: np.random.Generator):
+    def controller(self, robot: RobotModel, scene: Scene, rng: np.random.Generator):
         limits = robot.limits
         behaviour = BehaviourParams().for_robot(limits.v_max, limits.omega_max, robot.ir.max_range)
         return WanderController(robot.ir_bearings, rng, behaviour)

@@ -118,10 +118,11 @@ class World:
             frame.euler = [0, 0, slot.yaw]
             self.robots[slot.name] = Robot(
                 model=model,
-                controller=mission.controller(model, config.params, self.streams.get("robot", slot.name, "brain")),
+                controller=mission.controller(model, scene, self.streams.get("robot", slot.name, "brain")),
                 drive=make_locomotion(model.drive, model.limits, self.control_dt),
                 ir_rng=self.streams.get("robot", slot.name, "ir"), dormant=slot.dormant,
                 spawn=(slot.x, slot.y, slot.yaw))
+        self.scene = scene
         self.bogs = list(scene.bogs)
         self.check_faults(config.faults)
         self.faults = sorted(config.faults, key=lambda f: f.time)

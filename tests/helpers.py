@@ -33,7 +33,7 @@ class ScriptedMission(WanderMission):
         self.v, self.omega = v, omega
         self.controllers: dict[str, ScriptedController] = {}
 
-    def controller(self, robot, params, rng):
+    def controller(self, robot, scene, rng):
         self.controllers[robot.name] = ScriptedController(self.v, self.omega)
         return self.controllers[robot.name]
 
