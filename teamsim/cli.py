@@ -53,10 +53,58 @@ def _build_parser() -> argparse.ArgumentParser:
     export.add_argument("robot")
     export.add_argument("--out", type=Path, required=True)
 
+    study = commands.add_parser("study", help="re-run a thesis's experiments and compare with its figures")
+    studies = study.add_subparsers(dest="study", required=True, parser_class=_Parser)
+    navigation = studies.add_parser("navigation", help="Chand ch.3: navigation methods x robots x densities")
+    navigation.add_argument("--robots", type=_csv_of("robot", ("A", "B", "C", "tricycle", "diffdrive", "tracked")))
+    navigation.add_argument("--densities", type=_csv_of("density", None, float))
+    navigation.add_argument("--controllers", type=_csv_of("controller", ("FRC", "HRDK", "HRDU", "ODW", "ODWDS",
+                                                                      "RFRC")))
+    navigation.add_argument("--trials", type=_positive_int("--trials"))
+    navigation.add_argument("--workers", type=_positive_int("--workers"))
+    navigation.add_argument("--seed", type=int)
+    navigation.add_argument("--out", type=Path, default=Path("renders/study-navigation"))
+
     bench = commands.add_parser("bench", help="benchmarks")
     bench.add_argument("what", choices=("physics", "render"))
     bench.add_argument("--seconds", type=float, default=None, help="simulated seconds per measurement")
     return parser
+
+
+def _csv_of(name: str, allowed: tuple | None, kind=str):
+    """An argparse type: a comma-separated list of ``kind`` values, each in ``allowed`` when given."""
+    def parse(text: str) -> tuple:
+        try:
+            values = tuple(kind(item.strip()) for item in text.split(",") if item.strip())
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{name}s must be {kind.__name__}s separated by commas") from None
+        bad = [v for v in values if allowed is not None and v not in allowed]
+        if bad or not values:
+            raise argparse.ArgumentTypeError(f"{name} {bad[0] if bad else text!r} not allowed; allowed: "
+                                             f"{', '.join(map(str, allowed or ()))}")
+        return values
+    return parse
+
+
+def _positive_int(flag: str):
+    def parse(text: str) -> int:
+        if not text.isdigit() or int(text) < 1:
+            raise argparse.ArgumentTypeError(f"{flag} must be a whole number >= 1")
+        return int(text)
+    return parse
+
+
+def cmd_study(args) -> int:
+    if args.study == "navigation":
+        from teamsim.tasks.navigation_study import run_study, study_from_args
+
+        if args.densities and not all(0.0 < d <= 0.3 for d in args.densities):
+            raise ConfigError("--densities: each must be in (0, 0.3]")
+        study = study_from_args(robots=args.robots, densities=args.densities, controllers=args.controllers,
+                                trials=args.trials, workers=args.workers, out=args.out, seed=args.seed)
+        out = run_study(study)
+        print(f"wrote {out / 'report.md'} and {out / 'results.csv'}")
+    return 0
 
 
 def _trial_config(args) -> TrialConfig:
@@ -108,7 +156,8 @@ def cmd_list(_args) -> int:
     print("missions:")
     for name, mission in MISSIONS.items():
         print(f"  {name:<10} {mission.summary}")
-    print("studies:\n  (none yet)")
+    print("studies:")
+    print("  navigation       Chand ch.3: FRC, HRDK, HRDU, ODW, ODWDS, RFRC x robots A, B, C x densities")
     return 0
 
 
@@ -145,7 +194,7 @@ def main(argv: list[str] | None = None) -> int:
     try:
         args = parser.parse_args(argv)
         return {"run": cmd_run, "list": cmd_list, "render": cmd_render, "export": cmd_export,
-                "bench": cmd_bench}[args.command](args)
+                "bench": cmd_bench, "study": cmd_study}[args.command](args)
     except (UsageError, ConfigError, RenderBackendError) as exc:
         print(f"teamsim: error: {exc}", file=sys.stderr)
         return EXIT_USAGE

@@ -1,0 +1,100 @@
+"""The direction sensor, Chand's "polar histogram technique" (§3.4, eq. 3.9-3.10, Table 3.2).
+
+The first stage of reactive control: it turns the heading to the target into a modified target heading that keeps
+clear of obstacles. Kinematics, dynamics and the robot's shape are ignored here: the robot is a point and every
+obstacle is enlarged by r_m, the radius of the circle enclosing the robot. ``N_theta`` candidate directions,
+evenly spread over the full circle starting straight ahead, are scored by
+  (3.10) o_ds(theta_dir) = alpha1 (1 - |theta_dir - theta_t| / pi) + beta smooth(d_ob) / d_obmax
+and the best becomes theta_tmod. d_ob(theta_dir) is the distance to the nearest obstacle along the candidate
+direction, limited to [r_m, d_obmax] (d_obmax the sensing range).
+
+Frames and choices where the thesis is silent:
+  - (3.9) prints theta_t = atan((x_g - x_c)/(y_g - y_c)): the thesis measures headings from the y axis. teamsim
+    measures them from the world x axis, counter-clockwise (the positioning fix's heading), so here
+    theta_t = atan2(y_g - y_c, x_g - x_c), the same direction in this frame. Angles are normalised to [-pi, pi).
+  - everything below works in the robot frame (x forward, y left) centred on the robot's physical centre, as
+    §3.4 subtracts theta_c; |theta_dir - theta_t| is the wrapped angular difference, in [0, pi].
+  - d_ob is measured from the robot's centre to the obstacle's surface along the direction: r_m plus the free
+    distance the point robot can travel before entering an enlarged obstacle, limited to [r_m, d_obmax]. An
+    obstacle touching the rim gives r_m, the stated minimum. (The other reading, the free distance alone clipped
+    to [r_m, d_obmax], scored the same in the kinematic trials within their noise.)
+  - smooth() is "a weighted average of adjacent obstacle distances"; its weights are not given: a circular
+    [1/4, 1/2, 1/4] kernel is used.
+  - near-ties are broken towards the previous choice (``modified_target_heading``); the thesis takes the plain
+    maximum, which swings between the two ways round an obstacle straight ahead.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+
+@dataclass(frozen=True)
+class DirectionSensorParams:
+    alpha1: float = 0.5  # Table 3.2: weight of goal-directedness
+    beta: float = 1.0  # Table 3.2: weight of obstacle clearance
+    max_distance: float = 1.5  # Table 3.2: d_obmax, m, the IR range
+    directions: int = 41  # Table 3.2: N_theta, candidate directions over 360 degrees
+    smoothing: tuple[float, ...] = (0.25, 0.5, 0.25)  # smooth()'s kernel: not given, chosen
+    tie_tolerance: float = 0.02  # objective difference treated as a tie (not in the thesis; see below); below
+    # alpha1 2 pi / (41 pi) = 0.024, one candidate step of goal-directedness, so open space still aims exactly
+
+
+def wrap(angle):
+    """Angles in [-pi, pi)."""
+    return (np.asarray(angle, float) + np.pi) % (2 * np.pi) - np.pi
+
+
+def target_heading(x_c: float, y_c: float, x_g: float, y_g: float) -> float:
+    """(3.9), measured from the world x axis (see the module notes)."""
+    return float(wrap(np.arctan2(y_g - y_c, x_g - x_c)))
+
+
+def candidate_directions(count: int) -> np.ndarray:
+    """``count`` directions evenly over the circle, the first straight ahead, in [-pi, pi)."""
+    return wrap(2 * np.pi * np.arange(count) / count)
+
+
+def obstacle_distances(points: np.ndarray, directions: np.ndarray, robot_radius: float,
+                       max_distance: float) -> np.ndarray:
+    """d_ob per direction: r_m plus the free travel of the point robot before an enlarged obstacle, limited to
+    [r_m, d_obmax]. ``points`` are obstacle points (m, 2) relative to the robot's centre, in the robot frame."""
+    points = np.asarray(points, float).reshape(-1, 2)
+    ux, uy = np.cos(directions)[:, None], np.sin(directions)[:, None]
+    along = ux * points[:, 0] + uy * points[:, 1]  # (directions, points)
+    across = ux * points[:, 1] - uy * points[:, 0]
+    hits = (along > 0) & (np.abs(across) < robot_radius)
+    entry = along - np.sqrt(np.maximum(robot_radius ** 2 - across ** 2, 0.0))
+    free = np.where(hits, np.maximum(entry, 0.0), np.inf).min(axis=1, initial=np.inf)
+    return np.clip(robot_radius + free, robot_radius, max_distance)
+
+
+def smooth(distances: np.ndarray, kernel: tuple[float, ...]) -> np.ndarray:
+    """Circular weighted average of each direction's distance with its neighbours' (odd-length kernel)."""
+    half = len(kernel) // 2
+    return sum(w * np.roll(distances, half - k) for k, w in enumerate(kernel))
+
+
+def direction_objective(directions: np.ndarray, target: float, smoothed: np.ndarray,
+                        params: DirectionSensorParams) -> np.ndarray:
+    """(3.10) for every candidate direction; ``target`` is theta_t in the robot frame."""
+    goal_directedness = 1.0 - np.abs(wrap(directions - target)) / np.pi
+    return params.alpha1 * goal_directedness + params.beta * smoothed / params.max_distance
+
+
+def modified_target_heading(points: np.ndarray, target: float, robot_radius: float,
+                            params: DirectionSensorParams = DirectionSensorParams(),
+                            previous: float | None = None) -> float:
+    """theta_tmod, in the robot frame, for target heading ``target`` (robot frame) and obstacle ``points``.
+
+    Directions scoring within ``params.tie_tolerance`` of the best count as ties, broken towards ``previous``
+    (the last theta_tmod, in the current robot frame): an obstacle dead ahead scores both ways round it almost
+    equally, and re-deciding every cycle would swing the robot between them."""
+    directions = candidate_directions(params.directions)
+    distances = obstacle_distances(points, directions, robot_radius, params.max_distance)
+    scores = direction_objective(directions, target, smooth(distances, params.smoothing), params)
+    if previous is None:
+        return float(directions[np.argmax(scores)])
+    ties = np.flatnonzero(scores >= scores.max() - params.tie_tolerance)
+    return float(directions[ties[np.argmin(np.abs(wrap(directions[ties] - previous)))]])

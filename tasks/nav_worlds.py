@@ -1,0 +1,227 @@
+"""Random obstacle worlds of Chand's navigation experiments (§3.6.2): 15 m x 15 m, evenly distributed rectilinear
+obstacles at 5, 10, 15 and 20 % density, the robot crossing from the top-left corner to the bottom-right (Fig 3.9).
+
+The thesis gives neither the obstacles' sizes nor how they were spread, only that they were "evenly distributed"
+and automatically generated. Here (choices, in ``NavWorldParams``):
+  - obstacles are axis-aligned boxes with half-sides drawn uniformly from ``half_size_range``: 1 m to 2 m across,
+    large enough that the IR ring cannot miss one well inside its range (a box 1 m wide spans the 36 degrees
+    between adjacent beams of a ten-sensor ring out to 1.6 m from its centre);
+  - the world is divided into a square grid of strata, about one per obstacle expected, visited in a random order
+    again and again; each visit tries to drop one box at a uniform position in its stratum that overlaps neither
+    another box nor the clear discs around the start and the goal (a jittered grid: even, yet random);
+  - boxes are added until the covered fraction of the occupancy raster is as close to the density as one more
+    box could bring it.
+Density is measured on the occupancy raster (a cell is occupied when its centre lies in a box), which is also
+the known map the deliberative planners get. The world is centred on the origin, as ``walled_room`` builds it.
+
+``kinematic_run`` drives a navigation controller through a world without physics (ideal IR ranges by ray casting,
+unicycle or bicycle kinematics): the smoke test of the controllers and the timing of their decisions.
+"""
+from __future__ import annotations
+
+import math
+import time as time_module
+from dataclasses import dataclass
+
+import numpy as np
+
+from teamsim.controllers.base import Observation
+from teamsim.controllers.occupancy_grid import OccupancyGrid
+from teamsim.models.arenas import Box
+from teamsim.models.robot import DriveLimits
+from teamsim.positioning import PoseFix
+
+DENSITIES = (0.05, 0.10, 0.15, 0.20)  # §3.6.2
+
+
+@dataclass(frozen=True)
+class NavWorldParams:
+    size: float = 15.0  # m, side of the square world (§3.6.2)
+    resolution: float = 0.1  # m, occupancy raster cell
+    half_size_range: tuple[float, float] = (0.5, 1.0)  # m, obstacle half-sides: not given, chosen
+    corner_margin: float = 1.5  # m from each wall to the start and the goal
+    clear_radius: float = 1.2  # m around the start and the goal kept free of obstacles
+    attempts: int = 20  # placements tried per stratum visit before moving on
+    max_rounds: int = 50  # passes over the strata before giving up on a density
+
+
+@dataclass(frozen=True)
+class NavWorld:
+    boxes: tuple[Box, ...]
+    occupancy: np.ndarray  # bool (rows, cols), row along world y, column along x
+    origin: tuple[float, float]  # world position of the raster's lower-left corner
+    resolution: float
+    size: float
+    start: tuple[float, float, float]  # x, y, heading (facing the goal)
+    goal: tuple[float, float]
+
+    @property
+    def density(self) -> float:
+        return float(self.occupancy.mean())
+
+    def known_map(self) -> OccupancyGrid:
+        """The occupancy raster as a known map, for HRDK."""
+        return OccupancyGrid.known(self.origin, self.resolution, self.occupancy)
+
+    def unexplored_map(self) -> OccupancyGrid:
+        """An unexplored map of the same extent, for HRDU."""
+        return OccupancyGrid.unexplored(self.origin, self.resolution, self.occupancy.shape)
+
+
+def random_world(density: float, rng: np.random.Generator, params: NavWorldParams = NavWorldParams()) -> NavWorld:
+    """A world of the given obstacle density (a fraction), reproducible from ``rng``."""
+    half = params.size / 2
+    cells = round(params.size / params.resolution)
+    origin = (-half, -half)
+    centres = -half + (np.arange(cells) + 0.5) * params.resolution
+    start = (-half + params.corner_margin, half - params.corner_margin)
+    goal = (half - params.corner_margin, -half + params.corner_margin)
+    heading = math.atan2(goal[1] - start[1], goal[0] - start[0])
+
+    lo, hi = params.half_size_range
+    mean_area = 4 * ((lo + hi) / 2) ** 2
+    strata = max(1, round(math.sqrt(density * params.size ** 2 / mean_area)))
+    stratum = params.size / strata
+    occupancy = np.zeros((cells, cells), bool)
+    boxes: list[Box] = []
+    target = density * occupancy.size
+    for _ in range(params.max_rounds):
+        for k in rng.permutation(strata * strata):
+            row, col = divmod(int(k), strata)
+            footprint = _place(rng, params, (-half + col * stratum, -half + row * stratum), stratum,
+                               centres, occupancy, (start, goal))
+            if footprint is None:
+                continue
+            box, covered = footprint
+            added = np.count_nonzero(covered)
+            occupied = np.count_nonzero(occupancy)
+            if abs(occupied + added - target) >= abs(occupied - target):
+                return _world(boxes, occupancy, origin, params, start, heading, goal)
+            occupancy |= covered
+            boxes.append(box)
+    raise RuntimeError(f"could not reach {density:.0%} obstacle density in {params.max_rounds} rounds")
+
+
+def _place(rng: np.random.Generator, params: NavWorldParams, corner: tuple[float, float], stratum: float,
+           centres: np.ndarray, occupancy: np.ndarray, keep_clear) -> tuple[Box, np.ndarray] | None:
+    """A box centred in the stratum with lower-left ``corner``, inside the world, clear of the start, the goal
+    and every other box; with its raster footprint. None if no attempt fits."""
+    half_world = params.size / 2
+    for _ in range(params.attempts):
+        hx, hy = rng.uniform(*params.half_size_range, size=2)
+        x = corner[0] + rng.uniform(0, stratum)
+        y = corner[1] + rng.uniform(0, stratum)
+        if abs(x) + hx > half_world or abs(y) + hy > half_world:
+            continue
+        if any(math.hypot(max(abs(px - x) - hx, 0.0), max(abs(py - y) - hy, 0.0)) < params.clear_radius
+               for px, py in keep_clear):
+            continue
+        covered = (np.abs(centres - y)[:, None] <= hy) & (np.abs(centres - x)[None, :] <= hx)
+        if (covered & occupancy).any():
+            continue
+        return Box(float(x), float(y), float(hx), float(hy)), covered
+    return None
+
+
+def _world(boxes, occupancy, origin, params, start, heading, goal) -> NavWorld:
+    return NavWorld(tuple(boxes), occupancy, origin, params.resolution, params.size,
+                    (start[0], start[1], heading), goal)
+
+
+def ray_ranges(world: NavWorld, origins: np.ndarray, directions: np.ndarray, max_range: float) -> np.ndarray:
+    """Ideal range readings: distance from each origin (n, 2) along its unit direction (n, 2) to the first box
+    face or wall, ``inf`` beyond ``max_range`` (slab intersection, all rays and boxes at once)."""
+    lo = np.array([[b.x - b.half_x, b.y - b.half_y] for b in world.boxes]).reshape(-1, 2)
+    hi = np.array([[b.x + b.half_x, b.y + b.half_y] for b in world.boxes]).reshape(-1, 2)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        inverse = 1.0 / directions  # inf along an axis the ray does not move on: the slab test still holds
+        t1 = (lo[None] - origins[:, None]) * inverse[:, None]
+        t2 = (hi[None] - origins[:, None]) * inverse[:, None]
+        near = np.nanmax(np.minimum(t1, t2), axis=2)
+        far = np.nanmin(np.maximum(t1, t2), axis=2)
+        half = world.size / 2
+        wall = np.nanmin(np.maximum((-half - origins) * inverse, (half - origins) * inverse), axis=1)
+    boxes = np.where((near <= far) & (near >= 0), near, np.inf).min(axis=1, initial=np.inf)
+    distance = np.minimum(boxes, wall)
+    return np.where(distance < max_range, distance, np.inf)
+
+
+def clearance(world: NavWorld, x: float, y: float) -> float:
+    """Distance from a point to the nearest box or wall."""
+    half = world.size / 2
+    walls = half - max(abs(x), abs(y))
+    boxes = [math.hypot(max(abs(x - b.x) - b.half_x, 0.0), max(abs(y - b.y) - b.half_y, 0.0)) for b in world.boxes]
+    return min([walls] + boxes)
+
+
+@dataclass(frozen=True)
+class KinematicRobot:
+    """What a physics-free run needs of a robot: its drive, its enclosing circle and its IR ring (evenly spaced
+    over 360 degrees from straight ahead, on the circle, as ``add_ir_ring`` builds them)."""
+    kind: str  # "tricycle" or a differential kind
+    limits: DriveLimits
+    radius: float  # enclosing circle, m
+    ir_count: int
+    ir_range: float = 1.5
+    centre_offset: float = 0.0  # the circle's centre ahead of the pose's reference point
+    wheelbase: float = 0.5  # tricycle only, as TricycleDims assumes
+    steer_max: float = math.radians(60)
+    steer_rate_max: float = 1.0
+
+
+@dataclass(frozen=True)
+class KinematicRun:
+    reached: bool  # the controller reported "arrived"
+    collided: bool  # the enclosing circle touched a box or wall
+    time: float  # s simulated
+    min_clearance: float  # m, between the enclosing circle and the nearest box or wall
+    decision_times: np.ndarray  # s of wall time per controller call
+
+
+def kinematic_run(world: NavWorld, controller, robot: KinematicRobot, duration: float,
+                  control_dt: float = 0.1, substeps: int = 5) -> KinematicRun:
+    """Drive ``controller`` from the world's start with ideal IR ranges and exact positioning fixes every control
+    tick. The command is clipped and slewed by the drive limits as the locomotion does; a tricycle's front wheel
+    turns towards atan(omega L / v) at its steering rate and the robot then follows the bicycle model, a
+    differential drive follows the unicycle model."""
+    lim = robot.limits
+    x, y, heading = world.start
+    v = omega = steer = 0.0
+    bearings = 2 * np.pi * np.arange(robot.ir_count) / robot.ir_count
+    decision_times = []
+    min_clearance = math.inf
+    steps = round(duration / control_dt)
+    for tick in range(steps):
+        time_now = tick * control_dt
+        cx, cy = x + robot.centre_offset * math.cos(heading), y + robot.centre_offset * math.sin(heading)
+        directions = np.column_stack([np.cos(heading + bearings), np.sin(heading + bearings)])
+        ranges = ray_ranges(world, np.array([cx, cy]) + robot.radius * directions, directions, robot.ir_range)
+        observation = Observation(time=time_now, robot="kinematic", ir_raw=ranges, ir_range=ranges,
+                                  ir_bearings=bearings, pose=PoseFix(x, y, heading, time_now))
+        began = time_module.perf_counter()
+        command = controller(observation)
+        decision_times.append(time_module.perf_counter() - began)
+        if command.behaviour == "arrived":
+            return KinematicRun(True, False, time_now, min_clearance, np.array(decision_times))
+        v += float(np.clip(np.clip(command.v, -lim.v_max, lim.v_max) - v, -lim.accel_max * control_dt,
+                           lim.accel_max * control_dt))
+        omega += float(np.clip(np.clip(command.omega, -lim.omega_max, lim.omega_max) - omega,
+                               -lim.angular_accel_max * control_dt, lim.angular_accel_max * control_dt))
+        turn_rate = omega
+        if robot.kind == "tricycle":
+            wanted = math.atan(omega * robot.wheelbase / v) if abs(v) > 1e-3 else steer
+            wanted = min(max(wanted, -robot.steer_max), robot.steer_max)
+            step = robot.steer_rate_max * control_dt
+            steer += min(max(wanted - steer, -step), step)
+            turn_rate = v * math.tan(steer) / robot.wheelbase
+        dt = control_dt / substeps
+        for _ in range(substeps):
+            x += v * dt * math.cos(heading)
+            y += v * dt * math.sin(heading)
+            heading += turn_rate * dt
+        heading = (heading + math.pi) % (2 * math.pi) - math.pi
+        cx, cy = x + robot.centre_offset * math.cos(heading), y + robot.centre_offset * math.sin(heading)
+        min_clearance = min(min_clearance, clearance(world, cx, cy) - robot.radius)
+        if min_clearance < 0:
+            return KinematicRun(False, True, time_now + control_dt, min_clearance, np.array(decision_times))
+    return KinematicRun(False, False, steps * control_dt, min_clearance, np.array(decision_times))

@@ -1,0 +1,125 @@
+"""``navigate``: one robot crosses one of Chand's random obstacle worlds from corner to corner (§3.6).
+
+The world is drawn from the trial seed at the requested density; the robot (a Table 3.1 robot by letter, or any
+wheeled kind) starts in the top-left corner facing the goal in the bottom-right one, driven by one of the
+navigation methods (FRC, RFRC, ODW, ODWDS, HRDK, HRDU). The trial ends when the robot stops at the goal or at
+the time limit (§3.6.2: 300 s at 5 and 10 % density, 450 s at 15 and 20 %). Metrics are the thesis's: NT
+(navigation time), PI (path index: the modified A*'s optimal path length on the known map over the length
+travelled), AV (average velocity over v_gmax) and success.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from teamsim.config import ConfigError, setting
+from teamsim.controllers import dynamic_window as dw
+from teamsim.controllers.astar import PlannerParams, plan_on_grid
+from teamsim.models import ROBOT_KINDS
+from teamsim.models.arenas import walled_room
+from teamsim.models.robot import RobotModel, TricycleSpec
+from teamsim.tasks.base import RobotSlot, Scene
+from teamsim.tasks.nav_worlds import NavWorldParams, random_world
+
+# Table 3.1's simulated robots: kind and the dimensions that differ from the kind's defaults.
+TABLE_3_1 = {
+    "A": ("tricycle", {}),  # pentagon, 0.5 m, v_gmax 0.5 m/s
+    "B": ("diffdrive", {"radius": 0.35}),  # circle, 0.35 m, 0.5 m/s
+    "C": ("tracked", {"radius": 0.67, "v_max": 0.3}),  # rectangle, 0.67 m, 0.3 m/s
+}
+METHODS = {"FRC": dw.FRC, "RFRC": dw.RFRC, "ODW": dw.ODW, "ODWDS": dw.ODWDS, "HRDK": dw.HRDK, "HRDU": dw.HRDU}
+NAV_KINDS = ("tricycle", "diffdrive", "tracked")
+
+
+def robot_of(name: str) -> tuple[str, dict]:
+    """(kind, builder options) for a Table 3.1 letter or a robot kind."""
+    return TABLE_3_1[name] if name in TABLE_3_1 else (name, {})
+
+
+def time_limit(density: float) -> float:
+    """§3.6.2: 300 s for the 5 and 10 % worlds, 450 s for 15 and 20 %."""
+    return 300.0 if density <= 0.10 + 1e-9 else 450.0
+
+
+@dataclass
+class NavigateParams:
+    robot: str = setting("B", choices=(*TABLE_3_1, *NAV_KINDS), meaning="Table 3.1 robot A, B, C, or a kind")
+    controller: str = setting("FRC", choices=tuple(METHODS), meaning="navigation method (§3.6.2)")
+    density: float = setting(0.10, lo=0.0, hi=0.30, meaning="obstacle density of the 15 m world (§3.6.2)")
+    world_seed: int = setting(-1, lo=-1, hi=2**31 - 1, meaning="world layout seed (-1: the trial seed)")
+
+    def check(self) -> None:
+        if self.robot in ROBOT_KINDS and self.robot not in NAV_KINDS:
+            raise ConfigError(f"robot={self.robot}: navigate drives {', '.join(NAV_KINDS)} (or A, B, C)")
+
+
+class NavigateMission:
+    name = "navigate"
+    summary = "one robot crosses a random obstacle world corner to corner (Chand §3.6)"
+    Params = NavigateParams
+    default_duration = 450.0
+
+    def build(self, params: NavigateParams, rng: np.random.Generator, newcomers, physics_dt: float) -> Scene:
+        if params.world_seed >= 0:
+            rng = np.random.default_rng(params.world_seed)
+        world = random_world(params.density, rng, NavWorldParams())
+        kind, options = robot_of(params.robot)
+        x, y, heading = world.start
+        arena = walled_room(world.size, world.size, obstacles=world.boxes, physics_dt=physics_dt)
+        arena.worldbody.add("site", name="goal", pos=[*world.goal, 0.01], size=[0.3, 0.005], type="cylinder",
+                            rgba=[0.1, 0.8, 0.2, 0.6])
+        slot = RobotSlot("red", kind, x, y, heading, options=options)
+        return Scene(arena=arena, robots=[slot], params=params,
+                     info={"nav_world": world, "time_limit": time_limit(params.density)})
+
+    def controller(self, robot: RobotModel, scene: Scene, rng: np.random.Generator):
+        params, world = scene.params, scene.info["nav_world"]
+        kwargs = {}
+        if isinstance(robot.drive, TricycleSpec):
+            # The tricycle's pose is its rear axle; its pentagon's centre is half a wheelbase ahead.
+            kwargs.update(centre_offset=robot.drive.wheelbase / 2, steering=robot.drive)
+        if params.controller == "HRDK":
+            kwargs["known_map"] = world.known_map()
+        elif params.controller == "HRDU":
+            kwargs["grid"] = world.unexplored_map()
+        controller = METHODS[params.controller](robot.limits, robot.kind, robot.footprint_radius, world.goal,
+                                                **kwargs)
+        scene.info["controller"] = controller
+        return controller
+
+    def done(self, world) -> bool:
+        return self._arrived(world) or world.time >= world.scene.info["time_limit"]
+
+    def _arrived(self, world) -> bool:
+        controller = world.scene.info["controller"]
+        return bool(controller.arrived)
+
+    def outcome(self, world) -> tuple[bool, dict]:
+        nav_world = world.scene.info["nav_world"]
+        robot = world.robots["red"]
+        x, y, _ = world.pose(robot)
+        reached = self._arrived(world) and math.dist((x, y), nav_world.goal) <= 0.5 + robot.model.footprint_radius
+        travelled = float(world.odometry()["red"])
+        planned = optimal_path_length(nav_world, robot.model.footprint_radius)
+        nav_time = world.time
+        v_max = robot.model.limits.v_max
+        metrics = {
+            "success": reached,
+            "nav_time": round(nav_time, 3),
+            "path_length": round(travelled, 3),
+            "planned_length": round(planned, 3),
+            "path_index": round(planned / travelled, 4) if reached and travelled > 0 else 0.0,
+            "avg_velocity": round(travelled / nav_time / v_max, 4) if nav_time > 0 else 0.0,
+            "density": round(nav_world.density, 4),
+            "final_distance_to_goal": round(math.dist((x, y), nav_world.goal), 3),
+        }
+        return reached, metrics
+
+
+def optimal_path_length(nav_world, robot_radius: float) -> float:
+    """Length (m) of the modified A*'s path on the known map (clearance cost included, as §3.6.2's PI uses)."""
+    path, result = plan_on_grid(nav_world.known_map(), nav_world.start[:2], nav_world.goal, PlannerParams(),
+                                robot_radius)
+    return float(np.hypot(*np.diff(path, axis=0).T).sum()) if result.reached else math.nan

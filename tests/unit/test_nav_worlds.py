@@ -1,0 +1,138 @@
+"""Unit tests for Chand's random navigation worlds (§3.6.2): reproducibility, density, clear start and goal,
+even spread, the occupancy raster, ideal IR ranges and the kinematic runner."""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from teamsim.controllers.base import Command
+from teamsim.models.arenas import Box
+from teamsim.models.robot import DriveLimits
+from teamsim.tasks.nav_worlds import (DENSITIES, KinematicRobot, NavWorldParams, clearance, kinematic_run,
+                                      random_world, ray_ranges)
+
+PARAMS = NavWorldParams()
+
+
+def world(density=0.10, seed=0):
+    return random_world(density, np.random.default_rng(seed))
+
+
+def test_same_seed_same_world_and_different_seed_different_world():
+    a, b, c = world(seed=7), world(seed=7), world(seed=8)
+    assert a.boxes == b.boxes
+    np.testing.assert_array_equal(a.occupancy, b.occupancy)
+    assert a.boxes != c.boxes
+
+
+@pytest.mark.parametrize("density", DENSITIES)
+def test_density_within_one_percent(density):
+    for seed in range(10):
+        assert world(density, seed).density == pytest.approx(density, abs=0.01)
+
+
+def test_boxes_are_arena_boxes_inside_the_world():
+    w = world(0.20, 3)
+    half = w.size / 2
+    for box in w.boxes:
+        assert isinstance(box, Box)
+        assert PARAMS.half_size_range[0] <= box.half_x <= PARAMS.half_size_range[1]
+        assert abs(box.x) + box.half_x <= half and abs(box.y) + box.half_y <= half
+
+
+def test_start_and_goal_are_clear_corners():
+    for seed in range(10):
+        w = world(0.20, seed)
+        x, y, heading = w.start
+        assert (x, y) == (-7.5 + PARAMS.corner_margin, 7.5 - PARAMS.corner_margin)  # top left
+        assert w.goal == (7.5 - PARAMS.corner_margin, -7.5 + PARAMS.corner_margin)  # bottom right
+        assert heading == pytest.approx(-math.pi / 4)
+        assert clearance(w, x, y) >= min(PARAMS.clear_radius, PARAMS.corner_margin)
+        assert clearance(w, *w.goal) >= min(PARAMS.clear_radius, PARAMS.corner_margin)
+        rows, cols = w.known_map().world_to_cell(np.array([x, w.goal[0]]), np.array([y, w.goal[1]]))
+        assert not w.occupancy[rows, cols].any()
+
+
+def test_occupancy_is_the_raster_of_non_overlapping_boxes():
+    w = world(0.15, 4)
+    grid = w.known_map()
+    rows, cols = np.indices(w.occupancy.shape)
+    x, y = grid.cell_to_world(rows, cols)
+    inside = np.zeros(w.occupancy.shape, int)
+    for box in w.boxes:
+        inside += (np.abs(x - box.x) <= box.half_x) & (np.abs(y - box.y) <= box.half_y)
+    assert inside.max() == 1  # boxes never share a cell
+    np.testing.assert_array_equal(w.occupancy, inside == 1)
+
+
+def test_obstacles_are_spread_over_the_whole_world():
+    for seed in range(10):
+        blocks = world(0.20, seed).occupancy.reshape(3, 50, 3, 50).mean(axis=(1, 3))  # 5 m x 5 m blocks
+        assert blocks.min() > 0.0 and blocks.max() < 0.5
+
+
+def test_known_and_unexplored_maps():
+    w = world()
+    known, unexplored = w.known_map(), w.unexplored_map()
+    assert known.shape == unexplored.shape == (150, 150)
+    assert set(np.unique(known.probabilities)) == {0.05, 0.95}
+    assert np.all(unexplored.probabilities == 0.5)
+
+
+# ---------------------------------------------------------------- ray casting and the kinematic runner
+
+
+def empty_world(*boxes):
+    w = world(0.05, 0)
+    return type(w)(tuple(boxes), w.occupancy, w.origin, w.resolution, w.size, w.start, w.goal)
+
+
+def test_ray_ranges_by_hand():
+    w = empty_world(Box(2.0, 0.0, 0.5, 0.5))
+    origins = np.zeros((4, 2))
+    directions = np.array([[1.0, 0.0], [0.0, 1.0], [-1.0, 0.0], [math.sqrt(0.5), math.sqrt(0.5)]])
+    ranges = ray_ranges(w, origins, directions, max_range=12.0)
+    np.testing.assert_allclose(ranges, [1.5, 7.5, 7.5, 7.5 * math.sqrt(2)])
+    np.testing.assert_array_equal(ray_ranges(w, origins, directions, max_range=10.0)[[0, 3]], [1.5, np.inf])
+
+
+def test_clearance_by_hand():
+    w = empty_world(Box(2.0, 0.0, 0.5, 0.5))
+    assert clearance(w, 0.0, 0.0) == pytest.approx(1.5)
+    assert clearance(w, 3.0, 1.0) == pytest.approx(math.hypot(0.5, 0.5))
+    assert clearance(w, 7.0, 5.0) == pytest.approx(0.5)  # the east wall
+
+
+class Constant:
+    def __init__(self, v, omega):
+        self.v, self.omega = v, omega
+
+    def __call__(self, observation):
+        return Command(v=self.v, omega=self.omega)
+
+
+LIMITS = DriveLimits(0.5, math.pi / 7, 0.1, 0.15)
+
+
+def test_kinematic_run_drives_straight_into_a_wall():
+    w = empty_world()
+    robot = KinematicRobot("diffdrive", LIMITS, radius=0.35, ir_count=10)
+    run = kinematic_run(w, Constant(0.5, 0.0), robot, duration=60.0)
+    assert run.collided and not run.reached
+    # From the start, a margin below the north wall, heading -45 degrees, the circle meets the south and east
+    # walls after 15 m - margin - 0.35 m of descent; the 5 s climb to 0.5 m/s costs 2.5 s.
+    descent = 15.0 - PARAMS.corner_margin - 0.35
+    assert run.time == pytest.approx(descent * math.sqrt(2) / 0.5 + 2.5, abs=0.2)
+
+
+def test_kinematic_tricycle_turns_on_its_steering_circle():
+    w = empty_world()
+    robot = KinematicRobot("tricycle", LIMITS, radius=0.5, ir_count=11, centre_offset=0.25)
+    # 0.5 m turning radius: the centre, 0.25 m ahead of the rear axle, circles at 0.56 m, so the robot sweeps
+    # 1.06 m round a centre of rotation 1.15 m from the north wall.
+    run = kinematic_run(w, Constant(0.1, 0.2), robot, duration=60.0)
+    assert not run.collided and not run.reached
+    assert run.time == pytest.approx(60.0)
+    assert 0.0 < run.min_clearance < 0.2
