@@ -65,8 +65,15 @@ def _build_parser() -> argparse.ArgumentParser:
     navigation.add_argument("--seed", type=int)
     navigation.add_argument("--out", type=Path, default=Path("renders/study-navigation"))
 
+    lalliance = studies.add_parser("lalliance", help="Parker §4.5: abstract L-ALLIANCE allocation study")
+    lalliance.add_argument("--full", action="store_true", help="the thesis's full sweep (slow)")
+    lalliance.add_argument("--runs", type=_positive_int("--runs"), help="runs per scenario")
+    lalliance.add_argument("--workers", type=_positive_int("--workers"), default=2)
+    lalliance.add_argument("--seed", type=int, default=0)
+    lalliance.add_argument("--out", type=Path, default=Path("renders/study-lalliance"))
+
     bench = commands.add_parser("bench", help="benchmarks")
-    bench.add_argument("what", choices=("physics", "render"))
+    bench.add_argument("what", choices=("physics", "render", "nav", "alliance"))
     bench.add_argument("--seconds", type=float, default=None, help="simulated seconds per measurement")
     return parser
 
@@ -104,6 +111,12 @@ def cmd_study(args) -> int:
                                 trials=args.trials, workers=args.workers, out=args.out, seed=args.seed)
         out = run_study(study)
         print(f"wrote {out / 'report.md'} and {out / 'results.csv'}")
+    elif args.study == "lalliance":
+        from teamsim.tasks.lalliance_study import run_study
+
+        written = run_study(args.out, args.workers, full=args.full, runs=args.runs, seed=args.seed)
+        print(f"wrote {written['report']} and {written['results']} ({written['rows']} runs, "
+              f"{written['wall_s']:.0f} s)")
     return 0
 
 
@@ -158,6 +171,7 @@ def cmd_list(_args) -> int:
         print(f"  {name:<10} {mission.summary}")
     print("studies:")
     print("  navigation       Chand ch.3: FRC, HRDK, HRDU, ODW, ODWDS, RFRC x robots A, B, C x densities")
+    print("  lalliance        Parker §4.5: L-ALLIANCE strategies I-IV, abstract (no physics)")
     return 0
 
 
@@ -180,6 +194,16 @@ def cmd_export(args) -> int:
 def cmd_bench(args) -> int:
     from teamsim import bench
 
+    if args.what == "nav":
+        from teamsim.bench_nav import bench_nav
+
+        bench_nav()
+        return 0
+    if args.what == "alliance":
+        from teamsim.bench_alliance import bench_alliance
+
+        bench_alliance()
+        return 0
     if args.what == "physics":
         bench.physics(seconds=args.seconds or 10.0)
         print()
