@@ -218,6 +218,31 @@ def test_thesis_heuristic_finds_valid_paths_no_cheaper_than_optimal(case):
         assert result.cost >= reference[1] - 1e-9
 
 
+@pytest.mark.parametrize("seed", range(6))
+def test_batched_search_matches_the_reference_on_larger_grids(seed):
+    # Grids big enough that the octile search's batches hold many cells and re-open some; seeds 4 and 5 wall the
+    # goal in, so both searches exhaust the reachable cells and end on the same closest one.
+    rng = np.random.default_rng(seed)
+    size = 70
+    p = np.where(rng.random((size, size)) < 0.25, WALL, rng.uniform(0.05, 0.6, (size, size)))
+    start, goal = (1, 2), (size - 3, size - 2)
+    p[start] = p[goal] = FREE
+    if seed >= 4:
+        p[goal[0] - 2:goal[0] + 3, goal[1] - 2] = p[goal[0] - 2, goal[1] - 2:] = p[goal[0] + 2, goal[1] - 2:] = WALL
+    costs = cost_maps(p, PlannerParams(heuristic="octile"))
+    result = astar(costs, start, goal, "octile")
+    reference = reference_astar(costs.blocked, costs.multiplier, start, goal)
+    assert_valid_path(result.cells, costs.blocked, start)
+    assert result.cost == pytest.approx(path_cost(result.cells, costs.multiplier), rel=1e-9)
+    if reference is None:
+        assert not result.reached
+        heap = astar(costs, start, goal, "euclidean")  # the one-at-a-time search also ends on the nearest cell
+        assert tuple(result.cells[-1]) == tuple(heap.cells[-1])
+    else:
+        assert result.reached and tuple(result.cells[-1]) == goal
+        assert result.cost == pytest.approx(reference[1], rel=1e-9)
+
+
 def test_unknown_heuristic_is_refused():
     with pytest.raises(ValueError, match="heuristic"):
         astar(CostMaps(np.zeros((2, 2), bool), np.ones((2, 2))), (0, 0), (1, 1), heuristic="chebyshev")
