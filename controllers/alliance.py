@@ -37,8 +37,9 @@ Ambiguities of the thesis (spec §1.6) and how they are resolved, each behind a 
   the messages handed to this step; no switch.
 - items 6-7: one theta for every set (this module has no per-set threshold); every value is a config field.
 - Not in the spec's list, but open too: whether a teammate's newer message about another activity ends its
-  claim on the previous task at once. ``latest_message_supersedes`` (default True; False is the literal
-  ``comm_received(i,k,j,t-tau,t)``: the old claim stands until tau passes without a message about it).
+  claim on the previous task at once. ``latest_message_supersedes`` (default True: a teammate announcing another
+  activity has left the old task, and holding its claim would slow this robot for up to tau for nothing; False is
+  the literal ``comm_received(i,k,j,t-tau,t)``: the old claim stands until tau passes without a message about it).
 """
 from __future__ import annotations
 
@@ -264,10 +265,12 @@ class MotivationEvent:
 
 @dataclass(frozen=True)
 class StepTrace:
-    """One step of one robot: m_ij(t) per set, the growth rate held until the next step, the input that zeroed
-    each zeroed set, and the events."""
+    """One step of one robot: theta, m_ij(t) per set, the growth rate held until the next step, the input that
+    zeroed each zeroed set, and the events. It is the :class:`~teamsim.controllers.base.MotivationTrace` that
+    :class:`AllianceController` returns in its command, so every physics trial records it."""
 
     time: float
+    threshold: float
     active: str | None
     motivation: dict
     growth: dict
@@ -403,7 +406,7 @@ class AllianceRobot:
         elif was_active is None:
             self._select(time, theta, zeroed, events)
         self._hold_rates(time, theta, feedback, rates, gates, growth_override, claimants, events)
-        trace = StepTrace(time, self.active, dict(self.motivation), dict(self.growth), zeroed, tuple(events))
+        trace = StepTrace(time, theta, self.active, dict(self.motivation), dict(self.growth), zeroed, tuple(events))
         return self.active, trace
 
     def _select(self, time: float, theta: float, zeroed: dict, events: list) -> None:
@@ -510,9 +513,10 @@ class AllianceController:
 
     Every call evaluates each set's sensory feedback on the observation, runs the motivational behaviours on the
     radio inbox and ``robots_present``, then runs the active set's controller. The command's ``behaviour`` is
-    the active set's name ("idle" when none) and its ``broadcast`` is the activity message (merged over any
-    dict the set's controller broadcast). ``last_trace`` keeps the latest :class:`StepTrace` for HUDs and
-    timelines. Pass ``selector`` to run L-ALLIANCE (or any selector) over the same definitions.
+    the active set's name ("idle" when none), its ``broadcast`` is the activity message (merged over any dict the
+    set's controller broadcast) and its ``trace`` is the step's :class:`StepTrace`, which the world records in
+    ``events.jsonl`` and ``timeline.png`` plots (``last_trace`` keeps the latest). Pass ``selector`` to run
+    L-ALLIANCE (or any selector) over the same definitions.
     """
 
     def __init__(self, robot: str, definitions: Sequence[BehaviourSetDefinition],
@@ -531,9 +535,9 @@ class AllianceController:
                                            observation.robots_present)
         self.last_trace = trace
         if active is None:
-            return Command(behaviour=IDLE, broadcast=activity_message(None))
+            return Command(behaviour=IDLE, broadcast=activity_message(None), trace=trace)
         definition = self.definitions[active]
         command = definition.controller(observation)
         extras = command.broadcast if isinstance(command.broadcast, dict) else None
         return replace(command, behaviour=active,
-                       broadcast=activity_message(definition.behaviour_set.task, extras))
+                       broadcast=activity_message(definition.behaviour_set.task, extras), trace=trace)

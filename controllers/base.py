@@ -8,7 +8,7 @@ extras its robot has (gripper, ...), the message it wants to broadcast, and the 
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Any, Protocol
+from typing import Any, Mapping, Protocol, Sequence
 
 import numpy as np
 
@@ -30,6 +30,27 @@ class Observation:
     effectors: dict = field(default_factory=dict)  # effector -> position in [0, 1] from its encoder
 
 
+class TraceEvent(Protocol):
+    """Something a motivational behaviour did at a step: ``kind`` (e.g. "activate", "acquiescence"), the behaviour
+    set, the teammate concerned (or None) and a free-text detail."""
+
+    kind: str
+    behaviour_set: str
+    teammate: str | None
+    detail: str
+
+
+class MotivationTrace(Protocol):
+    """One step of a controller's action selection: ``motivation`` maps every behaviour set, in priority order
+    and the same sets at every step, to its level; a set is activated when its level exceeds ``threshold``."""
+
+    time: float
+    threshold: float
+    active: str | None
+    motivation: Mapping[str, float]
+    events: Sequence[TraceEvent]
+
+
 @dataclass(frozen=True)
 class Command:
     v: float = 0.0  # forward speed, m/s
@@ -37,6 +58,7 @@ class Command:
     behaviour: str = "idle"
     broadcast: Any = None  # payload for the next radio slot; None keeps the previous one
     extras: dict = field(default_factory=dict)  # effector set-points in [0, 1], e.g. {"grip": 0.0, "lift": 1.0}
+    trace: MotivationTrace | None = None  # action selection by motivation at this step, recorded by the world
 
 
 class Controller(Protocol):

@@ -5,7 +5,16 @@
 - ``events.jsonl``: one JSON event per line, flushed as it happens to ``events.jsonl.part`` and renamed
   when the trial ends; after a crash the ``.part`` file holds everything up to the crash.
 - ``trajectory.npz``: the state at the video rate (full ``qpos``, robot behaviours) plus the compiled scene's
-  MJCF, enough to re-render the trial with no other input; written atomically at the end.
+  MJCF, enough to re-render the trial with no other input; written atomically at the end. For robots whose
+  controller returns a motivation trace (``Command.trace``, see :mod:`teamsim.controllers.base`) it also holds
+  their motivation series at the control rate (:class:`MotivationRecorder`), which ``timeline.png`` plots.
+
+Motivation traces in ``events.jsonl``: every event of a trace is logged as it happens, as
+``{"event": "motivation", "robot", "kind", "behaviour_set", "teammate", "detail"}`` (kind: activate, deactivate,
+impatience, impatience_reset, acquiescence for ALLIANCE); the levels are logged as
+``{"event": "motivation_sample", "robot", "threshold", "active", "m": {set: level}}`` only when they changed,
+right after an event and otherwise at most once per ``SAMPLE_PERIOD`` of simulated time, which keeps the log
+small (the full series is in ``trajectory.npz``).
 """
 from __future__ import annotations
 
@@ -13,10 +22,16 @@ import io
 import json
 import math
 import os
+from array import array
+from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, Callable
 
 import numpy as np
+
+from teamsim.controllers.base import MotivationTrace
+
+SAMPLE_PERIOD = 1.0  # s of simulated time between motivation samples in events.jsonl while nothing happens
 
 
 def _jsonable(value: Any) -> Any:
@@ -99,13 +114,78 @@ class TrajectoryRecorder:
         """Behaviours as a (frames, robots) array of strings."""
         return np.array(self.behaviours, dtype=str).reshape(len(self.times), len(self.robot_names))
 
-    def save(self, path: Path) -> None:
+    def save(self, path: Path, extra: dict[str, np.ndarray] | None = None) -> None:
+        """Write the frames, and ``extra`` arrays under their own names (the motivation series)."""
         buffer = io.BytesIO()
         np.savez_compressed(
             buffer, model_xml=np.array(self.xml), robot_names=np.array(self.robot_names), fps=np.array(self.fps),
             time=np.array(self.times), qpos=np.array(self.qpos).reshape(len(self.times), -1),
-            behaviour=self.behaviour_array())
+            behaviour=self.behaviour_array(), **(extra or {}))
         write_atomic(path, buffer.getvalue())
+
+
+@dataclass
+class MotivationSeries:
+    """One robot's motivation trace at every control tick: its behaviour sets (priority order), theta, the tick
+    times, the levels (ticks x sets), the active set's index (-1: none) and the events (time, set index, kind,
+    detail)."""
+
+    sets: tuple[str, ...]
+    threshold: float
+    times: array = field(default_factory=lambda: array("d"))
+    levels: array = field(default_factory=lambda: array("d"))  # flattened, row-major
+    active: array = field(default_factory=lambda: array("i"))
+    events: list[tuple[float, int, str, str]] = field(default_factory=list)
+
+    def level_array(self) -> np.ndarray:
+        return np.frombuffer(self.levels, dtype=float).reshape(len(self.times), len(self.sets))
+
+    def arrays(self, prefix: str) -> dict[str, np.ndarray]:
+        """The series as named arrays for ``trajectory.npz``, each name starting with ``prefix``."""
+        times, sets, kinds, details = zip(*self.events) if self.events else ((), (), (), ())
+        return {f"{prefix}sets": np.array(self.sets, dtype=str), f"{prefix}threshold": np.array(self.threshold),
+                f"{prefix}time": np.array(self.times), f"{prefix}m": self.level_array(),
+                f"{prefix}active": np.array(self.active), f"{prefix}event_time": np.array(times, dtype=float),
+                f"{prefix}event_set": np.array(sets, dtype=int), f"{prefix}event_kind": np.array(kinds, dtype=str),
+                f"{prefix}event_detail": np.array(details, dtype=str)}
+
+
+class MotivationRecorder:
+    """Records the motivation traces the world hands over (``World.record_trace``): events and throttled samples
+    into the event log, the full series in memory (:class:`MotivationSeries` per robot)."""
+
+    def __init__(self, log: Callable[[dict], None], sample_period: float = SAMPLE_PERIOD):
+        self.log = log
+        self.sample_period = sample_period
+        self.series: dict[str, MotivationSeries] = {}
+        self._logged: dict[str, tuple[float, tuple]] = {}  # robot -> (time, levels) of its last logged sample
+
+    def __call__(self, robot: str, time: float, trace: MotivationTrace) -> None:
+        sets = tuple(trace.motivation)
+        series = self.series.setdefault(robot, MotivationSeries(sets, float(trace.threshold)))
+        if sets != series.sets:
+            raise ValueError(f"motivation trace of {robot}: behaviour sets changed from {list(series.sets)} to "
+                             f"{list(sets)}")
+        t = round(time, 6)
+        levels = tuple(round(float(m), 6) for m in trace.motivation.values())
+        series.times.append(time)
+        series.levels.extend(levels)
+        series.active.append(sets.index(trace.active) if trace.active is not None else -1)
+        for event in trace.events:
+            series.events.append((time, sets.index(event.behaviour_set), event.kind, event.detail))
+            self.log({"t": t, "event": "motivation", "robot": robot, "kind": event.kind,
+                      "behaviour_set": event.behaviour_set, "teammate": event.teammate, "detail": event.detail})
+        last = self._logged.get(robot)
+        due = last is None or bool(trace.events) or time - last[0] >= self.sample_period - 1e-9
+        if due and (last is None or levels != last[1]):
+            self.log({"t": t, "event": "motivation_sample", "robot": robot, "threshold": series.threshold,
+                      "active": trace.active, "m": dict(zip(sets, levels))})
+            self._logged[robot] = (time, levels)
+
+    def arrays(self) -> dict[str, np.ndarray]:
+        """Every robot's series for ``trajectory.npz``, named ``motivation/<robot>/<field>``."""
+        return {name: value for robot, series in self.series.items()
+                for name, value in series.arrays(f"motivation/{robot}/").items()}
 
 
 def load_trajectory(path: Path) -> dict:

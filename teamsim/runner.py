@@ -21,7 +21,7 @@ import numpy as np
 import teamsim
 from teamsim.config import ConfigError, TrialConfig, validate
 from teamsim.progress import Progress
-from teamsim.recording import EventLog, TrajectoryRecorder, write_json
+from teamsim.recording import EventLog, MotivationRecorder, TrajectoryRecorder, write_json
 from teamsim.tasks import MISSIONS
 from teamsim.timeline import write_timeline
 from teamsim.world import PhysicsUnstable, World
@@ -117,6 +117,8 @@ def run_trial(config: TrialConfig, seed: int | None = None, progress: bool | Non
     write_json(run_dir / "summary.json", summary)
     events = EventLog(run_dir / "events.jsonl")
     world.record = events
+    motivation = MotivationRecorder(events)
+    world.record_trace = motivation
     recorder = TrajectoryRecorder(world.xml, list(world.robots), config.video.fps, world.physics_dt)
     if renderer is not None:
         writer = Mp4Writer(run_dir / "video.mp4", config.video.width, config.video.height, config.video.fps)
@@ -148,10 +150,10 @@ def run_trial(config: TrialConfig, seed: int | None = None, progress: bool | Non
         bar.finish()
         events({"t": round(world.time, 6), "event": "trial_end", "status": status})
         events.close()
-        recorder.save(run_dir / "trajectory.npz")
+        recorder.save(run_dir / "trajectory.npz", motivation.arrays())
         if recorder.times:
             write_timeline(run_dir / "timeline.png", recorder.times, recorder.behaviour_array(), recorder.robot_names,
-                           [f.describe() for f in config.faults])
+                           [f.describe() for f in config.faults], motivation.series)
         if writer is not None:
             writer.close()
             renderer.close()

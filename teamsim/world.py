@@ -92,6 +92,7 @@ class World:
         self.mission = mission
         self.streams = RandomStreams(config.seed)
         self.record = events or (lambda event: None)
+        self.record_trace = lambda robot, time, trace: None  # gets each Command.trace (the runner records them)
         timing = config.timing
         self.physics_dt = timing.physics_dt
         self.steps_per_tick = max(1, round(timing.control_dt / timing.physics_dt))
@@ -278,6 +279,8 @@ class World:
         command: Command = robot.controller(observation)
         if not (math.isfinite(command.v) and math.isfinite(command.omega)):
             raise ValueError(f"controller of {robot.name} returned a non-finite command {command}")
+        if command.trace is not None:
+            self.record_trace(robot.name, now, command.trace)
         if command.behaviour != robot.behaviour:
             self.record({"t": round(now, 6), "event": "behaviour", "robot": robot.name,
                          "from": robot.behaviour, "to": command.behaviour})

@@ -208,11 +208,13 @@ def test_controller_runs_the_active_set_and_broadcasts_its_task():
     def observe(t):
         return controller(Observation(time=t, robot="red", ir_raw=NO_IR, ir_range=NO_IR, ir_bearings=NO_IR, pose=None))
 
-    assert observe(0.0) == Command(behaviour="idle", broadcast={"task": None})
+    idle = observe(0.0)
+    assert replace(idle, trace=None) == Command(behaviour="idle", broadcast={"task": None})
+    assert idle.trace.time == 0.0 and idle.trace.active is None and idle.trace.threshold == 1.0
     command = [observe(t) for t in grid(0.5, 5)][-1]
     assert command.behaviour == "find-methodical" and command.v == 0.2
     assert command.broadcast == {"corner": 3, "task": "find"}
-    assert controller.last_trace.active == "find-methodical"
+    assert command.trace is controller.last_trace and command.trace.active == "find-methodical"
     spill["found"] = True
     assert observe(5.5).behaviour == "idle"
     assert [observe(t) for t in grid(6, 11)][-1].broadcast == {"task": "move"}
