@@ -50,8 +50,9 @@ Ambiguities (spec §3.10), each behind a switch of :class:`LAllianceParams`:
   teammate's; ties make every tied robot category 1).
 - item 3, App. B's typos (task_time without its subscript, "~ 1" for "= 1", "Progress When Active"): read as
   §4.6 writes them; nothing to switch.
-- item 4, high == low: ``equal_times_delay`` ("midpoint" of the delay range, or "min_delay"). Footnote 6's
-  alternative, low and high given in advance, is ``expected_time_range``.
+- item 4, high == low: ``equal_times_delay`` ("midpoint" of the delay range: no task is then shorter or longer
+  than another, so neither end is favoured; or "min_delay"). Footnote 6's alternative, low and high given in
+  advance, is ``expected_time_range``.
 - item 5, strategies I and II come from Table 4.1; strategy I uses no teammate knowledge, so it has no category
   split (every task category 2 and never blinded) and its low/high span only its own times.
 - item 6, boredom's product form: ``boredom_rule`` ("any_set_active": boredom is 0 while any set is active, the

@@ -143,3 +143,4 @@ def test_study_writes_csv_and_report_and_is_deterministic(tmp_path):
                     "Claim 12", "Disagreements"):
         assert heading in report
     assert "different results on 0 of" in report
+    assert "teamsim counts 502" in report.split("## Disagreements")[1]  # the triple count is flagged
