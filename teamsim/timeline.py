@@ -71,7 +71,8 @@ def draw_timeline(times: np.ndarray, behaviours: np.ndarray, robot_names: list[s
     rows = [(ROW if r not in motivation else SET_ROW * len(motivation[r].sets)) for r in robot_names]
     tops = TOP + np.cumsum([0] + [h + GAP for h in rows[:-1]]).astype(int)
     axis_y = int(tops[-1] + rows[-1] + 4) if robot_names else TOP
-    legend_rows = (len(colours) + 5) // 6 + (1 if motivation else 0)
+    legend = _legend_layout(list(colours), WIDTH)
+    legend_rows = (legend[-1][1] + 1 if legend else 0) + (1 if motivation else 0)
     image = np.full((axis_y + 40 + 22 * legend_rows, left + WIDTH + 20, 3), 255, np.uint8)
     end = float(times[-1]) if len(times) > 1 else 1.0
 
@@ -105,8 +106,8 @@ def draw_timeline(times: np.ndarray, behaviours: np.ndarray, robot_names: list[s
             x, y = x_of(fault["time"]), int(tops[k])
             cv2.line(image, (x, y), (x, y + rows[k]), _RED, 2)
             _text(image, fault["kind"], x + 3, y + 12, 0.35, _RED)
-    for k, (name, colour) in enumerate(colours.items()):
-        x, y = left + (k % 6) * 165, axis_y + 32 + 22 * (k // 6)
+    for (name, colour), (offset, line) in zip(colours.items(), legend):
+        x, y = left + offset, axis_y + 32 + 22 * line
         cv2.rectangle(image, (x, y - 10), (x + 14, y + 2), colour, -1)
         cv2.rectangle(image, (x, y - 10), (x + 14, y + 2), _BLACK, 1)
         _text(image, name, x + 20, y)
@@ -167,6 +168,19 @@ def _shade_absence(image: np.ndarray, times: np.ndarray, column: np.ndarray, top
             overlay[:] = (overlay * 0.55 + np.array(_FIXED[column[start]]) * 0.45).astype(np.uint8)
             _text(image, str(column[start]), x0 + 3, top + height - 5, 0.35, (255, 255, 255) if
                   column[start] == "dead" else _BLACK)
+
+
+def _legend_layout(names: list[str], width: int) -> list[tuple[int, int]]:
+    """(x offset, line) of each colour key: entries on a 165 px grid, wider ones taking more cells, wrapping at
+    ``width``."""
+    places, x, line = [], 0, 0
+    for name in names:
+        cells = 165 * -(-(_text_width(name, 0.45) + 30) // 165)
+        if x and x + cells > width:
+            x, line = 0, line + 1
+        places.append((x, line))
+        x += cells
+    return places
 
 
 def _marker_legend(image: np.ndarray, x: int, y: int) -> None:
