@@ -65,17 +65,27 @@ def _build_parser() -> argparse.ArgumentParser:
     navigation.add_argument("--seed", type=int)
     navigation.add_argument("--out", type=Path, default=Path("renders/study-navigation"))
 
+    two_tier = studies.add_parser("two-tier-astar", help="Chand ch.4: memory-constrained vs monolithic A*")
+    two_tier.add_argument("--trials", type=_positive_int("--trials"), help="worlds per size and density")
+    _sweep_options(two_tier, "§4.6's whole grid of sizes and local maps (hours)", workers=1,
+                   out="renders/study-two-tier-astar")
+
     lalliance = studies.add_parser("lalliance", help="Parker §4.5: abstract L-ALLIANCE allocation study")
-    lalliance.add_argument("--full", action="store_true", help="the thesis's full sweep (slow)")
     lalliance.add_argument("--runs", type=_positive_int("--runs"), help="runs per scenario")
-    lalliance.add_argument("--workers", type=_positive_int("--workers"), default=2)
-    lalliance.add_argument("--seed", type=int, default=0)
-    lalliance.add_argument("--out", type=Path, default=Path("renders/study-lalliance"))
+    _sweep_options(lalliance, "the thesis's full sweep (slow)", workers=2, out="renders/study-lalliance")
 
     bench = commands.add_parser("bench", help="benchmarks")
     bench.add_argument("what", choices=("physics", "render", "nav", "alliance"))
     bench.add_argument("--seconds", type=float, default=None, help="simulated seconds per measurement")
     return parser
+
+
+def _sweep_options(parser: argparse.ArgumentParser, full_help: str, workers: int, out: str) -> None:
+    """--full, --workers, --seed and --out of a study that runs a reduced grid unless asked for the full one."""
+    parser.add_argument("--full", action="store_true", help=full_help)
+    parser.add_argument("--workers", type=_positive_int("--workers"), default=workers)
+    parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--out", type=Path, default=Path(out))
 
 
 def _csv_of(name: str, allowed: tuple | None, kind=str):
@@ -111,6 +121,12 @@ def cmd_study(args) -> int:
                                 trials=args.trials, workers=args.workers, out=args.out, seed=args.seed)
         out = run_study(study)
         print(f"wrote {out / 'report.md'} and {out / 'results.csv'}")
+    elif args.study == "two-tier-astar":
+        from teamsim.tasks.two_tier_study import plan, run_study
+
+        written = run_study(plan(args.full, args.trials, args.seed), args.out, args.workers)
+        print(f"wrote {written['report']} and {written['results']} ({written['rows']} plans, "
+              f"{written['wall_s']:.0f} s)")
     elif args.study == "lalliance":
         from teamsim.tasks.lalliance_study import run_study
 
@@ -171,6 +187,7 @@ def cmd_list(_args) -> int:
         print(f"  {name:<10} {mission.summary}")
     print("studies:")
     print("  navigation       Chand ch.3: FRC, HRDK, HRDU, ODW, ODWDS, RFRC x robots A, B, C x densities")
+    print("  two-tier-astar   Chand ch.4: memory-constrained two-tiered A* vs monolithic, no physics")
     print("  lalliance        Parker §4.5: L-ALLIANCE strategies I-IV, abstract (no physics)")
     return 0
 
