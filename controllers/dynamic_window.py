@@ -565,14 +565,17 @@ class DynamicWindowController:
     """A reactive navigator (FRC, RFRC, ODW or ODWDS) for one robot, driving to ``goal`` (x, y).
 
     ``centre_offset``: how far the robot's physical centre is ahead of its pose's reference point (the tricycle
-    model's is half its wheelbase). ``sensor_radius``: the IR sensors' distance from the centre (default: the
-    footprint radius). ``steering``: a tricycle's steering geometry (its TricycleSpec will do)."""
+    model's is half its wheelbase). ``sensor_radius``: the IR sensors' distance from the centre, one for all or
+    one per sensor in the order of the observation's readings (a polygon's sensors sit on its sides, nearer the
+    centre than its enclosing circle; default: the footprint radius). ``steering``: a tricycle's steering geometry
+    (its TricycleSpec will do)."""
     method = Method.FRC
 
     def __init__(self, limits: DriveLimits, kind: str, footprint_radius: float, goal: tuple[float, float], *,
                  params: DynamicWindowParams = DynamicWindowParams(),
                  direction: DirectionSensorParams = DirectionSensorParams(), centre_offset: float = 0.0,
-                 sensor_radius: float | None = None, steering=SteeringGeometry(), control_dt: float = 0.1,
+                 sensor_radius: float | np.ndarray | None = None, steering=SteeringGeometry(),
+                 control_dt: float = 0.1,
                  obstacle_memory: float = 2.0):
         self.window = DynamicWindow(limits, kind, footprint_radius, method=self.method, params=params,
                                     centre_offset=centre_offset, steering=steering, control_dt=control_dt)
@@ -580,7 +583,7 @@ class DynamicWindowController:
         self.direction = direction
         self.radius = footprint_radius
         self.offset = centre_offset
-        self.sensor_radius = footprint_radius if sensor_radius is None else sensor_radius
+        self.sensor_radius = np.asarray(footprint_radius if sensor_radius is None else sensor_radius, float)
         self.memory_seconds = obstacle_memory
         self.tracker = _PoseTracker(history_seconds=max(obstacle_memory, 2.0))
         self.memory: deque = deque()  # (time, obstacle points (m, 2) in the odometry frame)
@@ -625,7 +628,7 @@ class DynamicWindowController:
         ranges = np.asarray(obs.ir_range, float)
         bearings = np.asarray(obs.ir_bearings, float)
         seen = np.isfinite(ranges)
-        reach = self.sensor_radius + ranges[seen]
+        reach = np.broadcast_to(self.sensor_radius, ranges.shape)[seen] + ranges[seen]
         body = np.column_stack([self.offset + reach * np.cos(bearings[seen]), reach * np.sin(bearings[seen])])
         ox, oy, oth = self.tracker.odometry
         c, s = math.cos(oth), math.sin(oth)

@@ -111,13 +111,14 @@ class OccupancyGrid:
         return (row >= 0) & (row < self.shape[0]) & (col >= 0) & (col < self.shape[1])
 
     def update(self, pose: tuple[float, float, float], ranges: np.ndarray, bearings: np.ndarray, *,
-               sensor_radius: float, centre_offset: float = 0.0, footprint_radius: float = 0.0) -> None:
+               sensor_radius: float | np.ndarray, centre_offset: float = 0.0,
+               footprint_radius: float = 0.0) -> None:
         """Integrate one IR reading taken at robot ``pose`` (x, y, heading).
 
-        The sensors sit ``sensor_radius`` from the robot's physical centre, which is ``centre_offset`` ahead of
-        the pose's reference point, each looking out along its body-frame ``bearing``; ``ranges`` are measured
-        from the sensor, ``inf`` where the beam saw nothing. Cells within ``footprint_radius`` of the centre are
-        free (the robot is standing on them)."""
+        The sensors sit ``sensor_radius`` (one for all, or one per sensor) from the robot's physical centre,
+        which is ``centre_offset`` ahead of the pose's reference point, each looking out along its body-frame
+        ``bearing``; ``ranges`` are measured from the sensor, ``inf`` where the beam saw nothing. Cells within
+        ``footprint_radius`` of the centre are free (the robot is standing on them)."""
         p = self.params
         x, y, heading = (float(v) for v in pose)
         ranges = np.asarray(ranges, float)
@@ -126,7 +127,7 @@ class OccupancyGrid:
         directions = heading + bearings
         ux, uy = np.cos(directions), np.sin(directions)
         sx, sy = cx + sensor_radius * ux, cy + sensor_radius * uy
-        reach = sensor_radius + p.range_max + self.resolution
+        reach = float(np.max(sensor_radius)) + p.range_max + self.resolution
         rows, cols = self._window(cx, cy, reach)
         if rows.size == 0 or cols.size == 0:
             return

@@ -323,6 +323,13 @@ def test_obstacle_points_are_remembered_for_a_while():
     assert len(controller._remember(observation(1.5, bearings=[0.0]))) == 0
 
 
+def test_obstacle_points_use_each_sensors_distance_from_the_centre():
+    # A pentagon's sensors: the one looking forward sits on a vertex 0.5 m out, the one looking left on a side.
+    controller = FRC(LIMITS, "diffdrive", 0.5, goal=(5.0, 0.0), sensor_radius=[0.5, 0.405])
+    points = controller._remember(observation(0.0, ranges=[1.0, 1.0], bearings=[0.0, math.pi / 2]))
+    np.testing.assert_allclose(sorted(points.tolist()), [[0.0, 1.405], [1.5, 0.0]], atol=1e-9)
+
+
 def test_odw_ignores_the_direction_sensor():
     bearings = 2 * np.pi * np.arange(10) / 10
     ranges = np.where(np.isclose(bearings, 0.0), 0.85, np.inf)  # something straight ahead at 1.2 m

@@ -100,6 +100,17 @@ def test_a_beam_frees_the_cells_it_crosses_and_marks_the_hit():
     assert straight_ahead(g, -0.75) == 0.5  # behind
 
 
+def test_each_sensor_has_its_own_distance_from_the_centre():
+    g = grid()
+    # Two sensors looking along +x and +y, 0.2 m and 0.6 m from the centre, each seeing something 0.5 m away.
+    g.update((0.0, 0.0, 0.0), np.array([0.5, 0.5]), np.array([0.0, math.pi / 2]), sensor_radius=np.array([0.2, 0.6]))
+    assert straight_ahead(g, 0.7) > 0.5 and straight_ahead(g, 1.1) == 0.5
+    row, col = g.world_to_cell(0.0, 1.1)
+    assert g.probabilities[int(row), int(col)] > 0.5
+    row, col = g.world_to_cell(0.0, 0.5)
+    assert g.probabilities[int(row), int(col)] == 0.5  # inside the robot, before that sensor
+
+
 def test_free_evidence_is_stronger_near_the_sensor():
     g = grid()
     g.update((0.0, 0.0, 0.0), np.array([np.inf]), np.array([0.0]), sensor_radius=0.0)
