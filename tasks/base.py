@@ -32,6 +32,7 @@ class Scene:
     bogs: list = field(default_factory=list)  # teamsim.models.arenas.Bog zones, already drawn in the arena
     params: Any = None  # the mission parameters it was built from
     info: dict = field(default_factory=dict)  # whatever else the mission needs later (goal, known map, ...)
+    faults: list = field(default_factory=list)  # teamsim.faults.Fault the scenario starts with (a dead sensor, ...)
 
 
 class Mission(Protocol):

@@ -1,7 +1,7 @@
 """Faults as scenario data: what goes wrong, to which robot, and when (DESIGN.md, "Faults").
 
 CLI form: ``KIND:ROBOT@SECONDS[,key=value...]``, e.g. ``kill:red@60``, ``blind-ir:green@30``,
-``radio-off:blue@0``, ``slow:red@10,factor=0.5``, ``break-motor:red@5,motor=left``,
+``radio-off:blue@0``, ``slow:red@10,factor=0.5``, ``blind-ir:green@0,sensors=ir_left+ir_right``, ``break-motor:red@5,motor=left``,
 ``add-robot:purple@20,kind=diffdrive``. The world applies each fault at its time and records an event; a
 fault only changes a robot's :class:`Health`, which the world consults when sensing and actuating.
 """
@@ -16,7 +16,7 @@ from teamsim.config import ConfigError
 # kind -> {option: (parser, default, meaning)}
 FAULT_OPTIONS: dict[str, dict[str, tuple]] = {
     "kill": {},
-    "blind-ir": {},
+    "blind-ir": {"sensors": (str, None, "IR sensor names or name prefixes joined by '+' (default: every sensor)")},
     "radio-off": {},
     "radio-on": {},
     "break-motor": {"motor": (str, None, "locomotion motor name (default: the first)")},
@@ -45,7 +45,7 @@ class Fault:
 class Health:
     """What faults have done to one robot so far."""
     alive: bool = True
-    ir_blind: bool = False
+    ir_blind: tuple = ()  # name prefixes of the blinded IR sensors ("" blinds them all)
     radio_on: bool = True
     gripper_broken: bool = False
     speed_factor: float = 1.0
@@ -89,7 +89,7 @@ def apply_fault(fault: Fault, health: Health, motor_names: tuple[str, ...]) -> N
         health.alive = False
         health.radio_on = False
     elif kind == "blind-ir":
-        health.ir_blind = True
+        health.ir_blind += tuple(fault.options.get("sensors", "").split("+"))
     elif kind == "radio-off":
         health.radio_on = False
     elif kind == "radio-on":

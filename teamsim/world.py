@@ -35,6 +35,7 @@ UNSTABLE_WARNINGS = tuple(int(w) for w in (
     mujoco.mjtWarning.mjWARN_INERTIA, mujoco.mjtWarning.mjWARN_CONTACTFULL, mujoco.mjtWarning.mjWARN_CNSTRFULL,
     mujoco.mjtWarning.mjWARN_BADQPOS, mujoco.mjtWarning.mjWARN_BADQVEL, mujoco.mjtWarning.mjWARN_BADQACC))
 PARKING_X = 1000.0  # m; dormant robots wait here, far outside every arena, until an add-robot fault
+EFFECTOR_STILL = 1e-3  # encoder change per control tick (of a [0, 1] range) below which an effector motor is idle
 
 
 class PhysicsUnstable(RuntimeError):
@@ -52,7 +53,8 @@ class Robot:
     spawn: tuple[float, float, float]
     health: Health = field(default_factory=Health)
     behaviour: str = "idle"
-    parker_energy: float = 0.0  # Parker's count: 1 unit per second while any motor is commanded
+    parker_energy: float = 0.0  # Parker's count (ch.5): 1 unit per second while any motor is in use
+    effector_positions: dict = field(default_factory=dict)  # encoder readings at the last tick
     behaviour_time: dict = field(default_factory=dict)
     # model indices, filled by World
     qpos_adr: int = 0
@@ -71,6 +73,10 @@ class Robot:
     @property
     def active(self) -> bool:
         return self.health.alive and not self.dormant
+
+    def ir_blind_mask(self) -> np.ndarray:
+        prefixes = self.health.ir_blind
+        return np.array([any(name.startswith(p) for p in prefixes) for name in self.model.ir_sensors], bool)
 
 
 def bog_drag(robot: RobotModel) -> float:
@@ -125,8 +131,9 @@ class World:
                 spawn=(slot.x, slot.y, slot.yaw))
         self.scene = scene
         self.bogs = list(scene.bogs)
-        self.check_faults(config.faults)
-        self.faults = sorted(config.faults, key=lambda f: f.time)
+        faults = list(scene.faults) + list(config.faults)  # the scenario's own, then the user's
+        self.check_faults(faults)
+        self.faults = sorted(faults, key=lambda f: f.time)
         self.xml = scene.arena.to_xml_string()
         self.model = mujoco.MjModel.from_xml_string(self.xml, scene.arena.get_assets())
         self.data = mujoco.MjData(self.model)
@@ -154,6 +161,10 @@ class World:
                 raise ConfigError(f"{spec}: motor must be one of {', '.join(robot.model.motors)}")
             if fault.kind == "break-gripper" and not robot.model.effectors:
                 raise ConfigError(f"{spec}: a {robot.model.kind} robot has no gripper")
+            for prefix in fault.options.get("sensors", "").split("+") if fault.kind == "blind-ir" else ():
+                if not any(name.startswith(prefix) for name in robot.model.ir_sensors):
+                    raise ConfigError(f"{spec}: sensors: no IR sensor of {robot.name} starts with {prefix!r}; "
+                                      f"its sensors: {', '.join(robot.model.ir_sensors)}")
 
     def _index_model(self) -> None:
         m = self.model
@@ -256,7 +267,7 @@ class World:
             distance = self.data.sensordata[np.concatenate([robots[k].ir_adr for k in members])]
             # Each robot draws from its own stream, blind or not, so one robot's faults never shift another's.
             noise = np.concatenate([robots[k].ir_rng.standard_normal(len(robots[k].ir_adr)) for k in members])
-            blind = np.concatenate([np.full(len(robots[k].ir_adr), robots[k].health.ir_blind) for k in members])
+            blind = np.concatenate([robots[k].ir_blind_mask() for k in members])
             raw = np.where(blind, 0.0, ir.read(distance, noise))
             ranges = ir.to_range(raw)
             bounds = np.cumsum([0] + [len(robots[k].ir_adr) for k in members])
@@ -288,7 +299,10 @@ class World:
         robot.behaviour_time[robot.behaviour] = robot.behaviour_time.get(robot.behaviour, 0.0) + self.control_dt
         if command.broadcast is not None:
             self.radio.set_outbox(robot.name, command.broadcast)
-        if command.v or command.omega:
+        effectors_moved = any(abs(observation.effectors[n] - robot.effector_positions.get(n, observation.effectors[n]))
+                              > EFFECTOR_STILL for n in observation.effectors)
+        robot.effector_positions = observation.effectors
+        if command.v or command.omega or effectors_moved:
             robot.parker_energy += self.control_dt
         factor = robot.health.speed_factor
         if hasattr(robot.drive, "feedback"):

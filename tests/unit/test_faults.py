@@ -159,7 +159,7 @@ def applied(*specs: str) -> Health:
 def test_fresh_health_is_healthy():
     h = Health()
     assert (h.alive, h.ir_blind, h.radio_on, h.gripper_broken, h.speed_factor, h.broken_motors) == \
-           (True, False, True, False, 1.0, set())
+           (True, (), True, False, 1.0, set())
 
 
 def test_kill_silences_radio_too():
@@ -181,7 +181,8 @@ def test_radio_off_then_on():
 
 
 def test_blind_ir():
-    assert applied("blind-ir:red@1") == Health(ir_blind=True)
+    assert applied("blind-ir:red@1") == Health(ir_blind=("",))
+    assert applied("blind-ir:red@1,sensors=ir_left+ir_back") == Health(ir_blind=("ir_left", "ir_back"))
 
 
 def test_break_gripper():

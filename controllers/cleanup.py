@@ -1,0 +1,465 @@
+"""The hazardous-waste cleanup behaviour sets of Parker's R-2s (§3.8.1, Figs 3-4 to 3-8; spec §4.1).
+
+Every robot carries :class:`CleanupKnowledge`: what it believes about the mission (its home by the entrance, the
+room's extents, the spill and goal locations, when the team last reported, whether the spill is gone), built
+from its own sensing and from teammates' broadcasts. The behaviour sets' sensory feedback is read from it:
+
+- find-initial-final-locations (task ``find-locations``): applicable while the locations are unknown. Two
+  versions: *methodical* (Fig. 3-5, :class:`FindMethodical`) follows the walls with the side IR, keeping the
+  wall on the right, until back home; *wander* (Fig. 3-6, :class:`FindWander`) drives west, north, east and
+  south for a fixed time each. Both track the extremes of the robot's position and compute the centre of the
+  front third of the room (the spill) and the back centre (the goal) from them (:func:`locations_from_extents`).
+- move-spill (Fig. 3-7, :class:`MoveSpill`): applicable while the locations are known and the robot believes
+  pucks remain. One activation moves one load: go to the spill, sweep straight lines through it scanning with
+  the fingertip IR, zero in, grasp and lift, carry to the goal, lower and release. Its feedback falls for one
+  control period after each delivery (the load is moved), so the robot chooses afresh: that is when
+  report-progress, if due, can win (ch.5: "the only time a robot tries to initiate the report-progress task is
+  after it has completed the transport of a spill object").
+- report-progress (Fig. 3-8, :class:`ReportProgress`): applicable when a report is due (``report_interval``
+  since the last report this robot knows of) and it has delivered since. It drives to the entrance and reports,
+  by radio, which satisfies its teammates.
+
+The robot that finds the locations broadcasts them (the virtual sensor of §3.8.2), and every broadcast also
+carries the last report time and the spill-empty belief. With the radio off nothing is shared, so every capable
+robot finds the locations and reports for itself (ch.5's "no awareness").
+
+The avoid-obstacles layer (:class:`teamsim.controllers.goto.AvoidObstacles`) runs under every set except while
+move-spill sweeps and picks up (Fig. 3-4). Constants the thesis does not give are in :class:`CleanupParams`.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+
+from teamsim.config import setting
+from teamsim.controllers import gripper as G
+from teamsim.controllers.alliance import AllianceController, AllianceParams, BehaviourSetDefinition, MotivationRates
+from teamsim.controllers.base import Command, Observation
+from teamsim.controllers.goto import AvoidObstacles, DriveParams, steer_to, turn_to
+from teamsim.controllers.pose_estimate import PoseEstimate
+from teamsim.models.r2 import TIP_IR
+from teamsim.models.robot import RobotModel
+
+FIND, MOVE, REPORT = "find-locations", "move-spill", "report-progress"
+METHODICAL, WANDER = "find-locations-methodical", "find-locations-wander"
+RIGHT_SIDE_IR = ("ir_right_front", "ir_right_rear")
+
+
+@dataclass(frozen=True)
+class CleanupParams:
+    """Assumed constants of the cleanup behaviours (Parker names the behaviours, not their numbers)."""
+    report_interval: float = setting(240.0, lo=1.0, meaning="s between team progress reports ('about every 4 "
+                                                            "minutes', §3.8)")
+    wall_distance: float = 0.12  # m from the side IR to the wall while wall-following
+    wall_ahead: float = 0.22  # m: a fingertip reading nearer than this is a wall (or robot) ahead: turn left
+    follow_speed: float = 0.25  # m/s
+    home_leave: float = 2.0  # m: wall-following ends back within home_return of home after going this far
+    home_return: float = 0.8
+    wander_leg: float = 30.0  # s per compass direction of find-wander (a 7.9 m room at 0.3 m/s is 26 s)
+    spill_vicinity: float = 1.0  # m from the believed spill centre where sweeping starts
+    spill_radius: float = 0.6  # m: sweep lines pass within this of the believed spill centre
+    sweep_overshoot: float = 0.6  # m a sweep line runs past its random point
+    sweep_speed: float = 0.15  # m/s while scanning: 1.5 cm per control period
+    empty_lines: int = 12  # consecutive sweep lines without a puck: the spill is gone
+    goal_spread: float = 0.25  # m: deliveries land this far either side of the believed goal
+    goal_clearance: float = 0.45  # m: the drop point stands this far in from the goal-side extent
+    arrive: float = 0.2  # m: a waypoint is reached within this
+    lane_offset: float = 0.5  # m to the right of the direct line while travelling (keep right)
+    lane_merge: float = 1.0  # m: the lane merges into the direct line within this of the target
+    entrance_arrive: float = 0.5  # m: close enough to the entrance to report from
+    drive: DriveParams = field(default_factory=DriveParams)
+    # An approach ends within 12 s: 0.3 m of IR range at 6 cm/s plus the blind 4 s; longer means the fingertips
+    # saw a robot (Parker's R-2s also took each other's fingers for pucks, §3.8.4).
+    gripper: G.GripperParams = field(default_factory=lambda: G.GripperParams(approach_timeout=12.0))
+
+
+def locations_from_extents(extents: np.ndarray, home: np.ndarray, clearance: float) -> dict:
+    """Spill, goal and entrance from the extremes (xmin, xmax, ymin, ymax) a robot reached, §3.8.1.
+
+    The entrance wall is the one nearest home (the robots start at the entrance). The spill is the centre of
+    the third of the room nearest it; the goal is the centre of the opposite wall, ``clearance`` in from the
+    extreme so a robot can stand there; the entrance is the middle of the entrance-side extreme."""
+    xmin, xmax, ymin, ymax = extents
+    gaps = np.array([home[0] - xmin, xmax - home[0], home[1] - ymin, ymax - home[1]])
+    wall = int(np.argmin(gaps))
+    axis, sign = wall // 2, (1.0 if wall % 2 == 0 else -1.0)  # +1: the room extends in +axis from the entrance
+    low, high = extents[2 * axis], extents[2 * axis + 1]
+    near, far = (low, high) if sign > 0 else (high, low)
+    other = 0.5 * (extents[2 * (1 - axis)] + extents[2 * (1 - axis) + 1])
+
+    def point(along: float) -> tuple[float, float]:
+        return (along, other) if axis == 0 else (other, along)
+
+    return {"spill": point(near + sign * (high - low) / 6), "goal": point(far - sign * clearance),
+            "entrance": point(near)}
+
+
+@dataclass
+class CleanupKnowledge:
+    """One robot's beliefs about the mission, and its own tallies (transports, reports)."""
+    report_interval: float
+    home: np.ndarray | None = None
+    spill: tuple | None = None
+    goal: tuple | None = None
+    entrance: tuple | None = None
+    last_report: float = 0.0  # the mission's start counts as a report
+    delivered_since_report: bool = False
+    just_delivered: bool = False
+    spill_empty: bool = False
+    transports: int = 0
+    reports: int = 0
+
+    @property
+    def located(self) -> bool:
+        return self.goal is not None
+
+    def learn_locations(self, locations: dict) -> None:
+        if not self.located:
+            self.spill, self.goal, self.entrance = (tuple(locations[k]) for k in ("spill", "goal", "entrance"))
+
+    def hear(self, payload) -> None:
+        """Merge a teammate's broadcast."""
+        if not isinstance(payload, dict):
+            return
+        if "goal" in payload:
+            self.learn_locations(payload)
+        if payload.get("report", -math.inf) > self.last_report:
+            self.last_report = payload["report"]
+            self.delivered_since_report = False
+        self.spill_empty |= bool(payload.get("spill_empty", False))
+
+    def message(self) -> dict:
+        """What this robot tells its teammates in every broadcast."""
+        shared = {"report": self.last_report, "spill_empty": self.spill_empty}
+        if self.located:
+            shared.update(spill=self.spill, goal=self.goal, entrance=self.entrance)
+        return shared
+
+    def delivered(self) -> None:
+        self.transports += 1
+        self.delivered_since_report = self.just_delivered = True
+
+    def reported(self, now: float) -> None:
+        self.reports += 1
+        self.last_report = now
+        self.delivered_since_report = False
+
+    def report_due(self, now: float) -> bool:
+        return self.delivered_since_report and now - self.last_report >= self.report_interval
+
+
+class SetController:
+    """A behaviour set's competence layers: ``__call__`` on the robot's observation and pose estimate while the
+    set is active; ``restart`` when it stops being active, so the next activation begins afresh."""
+    name = ""
+
+    def __init__(self, knowledge: CleanupKnowledge, estimate: PoseEstimate, avoid: AvoidObstacles,
+                 params: CleanupParams):
+        self.knowledge, self.estimate, self.avoid, self.params = knowledge, estimate, avoid, params
+
+    def restart(self) -> None:
+        pass
+
+    def drive(self, v: float = 0.0, omega: float = 0.0, **extras) -> Command:
+        return Command(v=v, omega=omega, behaviour=self.name, extras={"grip": G.OPEN, "lift": G.DOWN, **extras})
+
+    def go(self, obs: Observation, target, arrive: float) -> Command | None:
+        """One step of go-to-point under avoid-obstacles; None on arrival."""
+        evasion = self.avoid(obs)
+        if evasion is not None:
+            return self.drive(*evasion)
+        step = steer_to(self.estimate.pose, self.lane(target), self.params.drive, arrive)
+        return None if step is None else self.drive(*step)
+
+    def lane(self, target) -> np.ndarray:
+        """Keep right: far from ``target``, aim ``lane_offset`` to the right of it, so robots travelling in
+        opposite directions between the same places pass each other instead of meeting head on."""
+        p, here = self.params, self.estimate.pose[:2]
+        ahead = np.asarray(target, float) - here
+        distance = float(np.hypot(*ahead))
+        if distance <= p.lane_merge:
+            return np.asarray(target, float)
+        right = np.array([ahead[1], -ahead[0]]) / distance
+        return np.asarray(target, float) + right * p.lane_offset * min(1.0, (distance - p.lane_merge) / p.lane_merge)
+
+
+class ExtentTracker(SetController):
+    """Shared by both find versions: track the extremes of the robot's position, then compute the locations."""
+
+    def restart(self) -> None:
+        self.extents = None
+
+    def track(self) -> None:
+        x, y = self.estimate.pose[:2]
+        if getattr(self, "extents", None) is None:
+            self.extents = np.array([x, x, y, y])
+        self.extents = np.array([min(self.extents[0], x), max(self.extents[1], x),
+                                 min(self.extents[2], y), max(self.extents[3], y)])
+
+    def conclude(self) -> Command:
+        self.knowledge.learn_locations(locations_from_extents(self.extents, self.knowledge.home,
+                                                              self.params.goal_clearance))
+        return self.drive()
+
+
+class FindMethodical(ExtentTracker):
+    """Fig. 3-5: wall-follow with the right-side IR, wall on the right, from home until back home."""
+    name = METHODICAL
+
+    def __init__(self, robot: RobotModel, *args):
+        super().__init__(*args)
+        self.side = [robot.ir_sensors.index(n) for n in RIGHT_SIDE_IR]
+        self.tips = [robot.ir_sensors.index(n) for n in TIP_IR]
+        self.restart()
+
+    def restart(self) -> None:
+        super().restart()
+        self.found_wall = False
+        self.far_from_home = False
+
+    def __call__(self, obs: Observation) -> Command:
+        p, home = self.params, self.knowledge.home
+        self.track()
+        distance_home = float(np.hypot(*(self.estimate.pose[:2] - home)))
+        self.far_from_home |= distance_home > p.home_leave
+        if self.far_from_home and distance_home < p.home_return:
+            return self.conclude()
+        ahead = min(obs.ir_range[self.tips])
+        front, rear = obs.ir_range[self.side]
+        if ahead < p.wall_ahead:
+            self.found_wall = True
+            return self.drive(0.0, p.drive.turn_rate)  # a corner (or a robot): turn left
+        if not self.found_wall:
+            omega = turn_to(self.estimate.pose, -math.pi / 2, p.drive)  # head south to the first wall
+            return self.drive(0.0 if omega else p.follow_speed, omega or 0.0)
+        if not (np.isfinite(front) or np.isfinite(rear)):
+            return self.drive(0.5 * p.follow_speed, -0.6 * p.drive.turn_rate)  # lost the wall: curve right
+        nearest = min(front, rear)
+        omega = -3.0 * (nearest - p.wall_distance)
+        if np.isfinite(front) and np.isfinite(rear):
+            omega -= 4.0 * (front - rear)
+        return self.drive(p.follow_speed, float(np.clip(omega, -p.drive.turn_rate, p.drive.turn_rate)))
+
+
+class FindWander(ExtentTracker):
+    """Fig. 3-6: drive west, north, east and south, ``wander_leg`` seconds each, stopping at whatever blocks."""
+    name = WANDER
+    HEADINGS = (math.pi, math.pi / 2, 0.0, -math.pi / 2)
+
+    def __init__(self, robot: RobotModel, *args):
+        super().__init__(*args)
+        self.tips = [robot.ir_sensors.index(n) for n in TIP_IR]
+        self.restart()
+
+    def restart(self) -> None:
+        super().restart()
+        self.started: float | None = None
+
+    def __call__(self, obs: Observation) -> Command:
+        p = self.params
+        if self.started is None:
+            self.started = obs.time
+        self.track()
+        leg = int((obs.time - self.started) // p.wander_leg)
+        if leg >= len(self.HEADINGS):
+            return self.conclude()
+        omega = turn_to(self.estimate.pose, self.HEADINGS[leg], p.drive)
+        if omega is not None:
+            return self.drive(0.0, omega)
+        blocked = min(obs.ir_range[self.tips]) < p.wall_ahead or obs.touch.get("bump_front", 0.0) >= p.drive.bump_force
+        return self.drive(0.0 if blocked else p.drive.cruise)
+
+
+class MoveSpill(SetController):
+    """Fig. 3-7: move one load from the spill to the goal, with the gripper behaviours of
+    :mod:`teamsim.controllers.gripper`; avoid-obstacles is off while sweeping and picking up."""
+    name = MOVE
+
+    def __init__(self, robot: RobotModel, rng: np.random.Generator, *args):
+        super().__init__(*args)
+        self.sensors = G.GripperSensors.of(robot)
+        self.rng = rng
+        self.restart()
+
+    def restart(self) -> None:
+        self.state = "to_spill"
+        self.line: tuple | None = None  # (heading, length, time scanning began or None while turning)
+        self.empty_lines = 0
+        self.step: G.Sequence | None = None
+        self.drop_point: tuple | None = None
+
+    def __call__(self, obs: Observation) -> Command:
+        handler = getattr(self, f"_{self.state}")
+        return handler(obs)
+
+    def _to_spill(self, obs: Observation) -> Command:
+        command = self.go(obs, self.knowledge.spill, self.params.spill_vicinity)
+        if command is not None:
+            return command
+        self.state = "sweep"
+        return self._sweep(obs)
+
+    def _sweep(self, obs: Observation) -> Command:
+        """"Wander in a straight line" through the spill area (Fig. 3-7 step 2): face a random point of it,
+        then drive straight past it, scanning with the fingertip IR; avoid-obstacles is off."""
+        p = self.params
+        if np.hypot(*(self.estimate.pose[:2] - self.knowledge.spill)) > p.spill_vicinity + p.spill_radius:
+            self.state, self.line = "to_spill", None  # a failed pick-up can leave it far off
+            return self._to_spill(obs)
+        if self.line is None:
+            self.line = self._new_line()
+        heading, length, scanning_since = self.line
+        if scanning_since is None:
+            omega = turn_to(self.estimate.pose, heading, p.drive, tolerance=0.05)
+            if omega is not None:
+                return self.drive(0.0, omega)
+            self.line = (heading, length, obs.time)
+            return self.drive()
+        seen = np.isfinite(obs.ir_range[[self.sensors.tip_left, self.sensors.tip_right]]).any()
+        if seen or any(self.sensors.beams(obs)):  # ahead of the jaw, or already in it
+            self.empty_lines = 0
+            self.line = None
+            g = self.sensors, self.params.gripper
+            return self._begin("pick", [G.Approach(*g), G.Grasp(*g), G.Lift(*g)], obs)
+        if obs.time - scanning_since > length / p.sweep_speed:
+            self.line = None
+            self.empty_lines += 1
+            if self.empty_lines >= p.empty_lines:
+                self.knowledge.spill_empty = True
+            return self.drive(-p.sweep_speed)
+        return self.drive(p.sweep_speed)
+
+    def _new_line(self) -> tuple:
+        """(heading, length, None): through a random point within ``spill_radius`` of the believed spill
+        centre, and ``sweep_overshoot`` beyond it."""
+        p = self.params
+        radius, bearing = p.spill_radius * math.sqrt(self.rng.random()), self.rng.uniform(-math.pi, math.pi)
+        point = np.asarray(self.knowledge.spill) + radius * np.array([math.cos(bearing), math.sin(bearing)])
+        dx, dy = point - self.estimate.pose[:2]
+        return math.atan2(dy, dx), math.hypot(dx, dy) + p.sweep_overshoot, None
+
+    def _begin(self, state: str, behaviours: list, obs: Observation) -> Command:
+        self.state, self.step = state, G.Sequence(behaviours)
+        return getattr(self, f"_{state}")(obs)
+
+    def _pick(self, obs: Observation) -> Command:
+        command = self.step(obs)
+        if self.step.status == G.FAILED:
+            return self._begin("recover", [G.Release(self.sensors, self.params.gripper)], obs)
+        if self.step.status == G.SUCCEEDED:
+            # Pucks get pushed about: look for the next one where this one was (the jaw is ahead of the pose).
+            x, y, heading = self.estimate.pose
+            self.knowledge.spill = (x + 0.13 * math.cos(heading), y + 0.13 * math.sin(heading))
+            goal = np.asarray(self.knowledge.goal)
+            self.drop_point = tuple(goal + self._across_goal() * self.rng.uniform(-1, 1) * self.params.goal_spread)
+            return self._begin("carry", [G.Carry(self.sensors, self._route_to_goal, self.params.gripper)], obs)
+        return replace(command, behaviour=self.name)
+
+    def _across_goal(self) -> np.ndarray:
+        """Unit vector along the goal wall (across the room's long axis)."""
+        k = self.knowledge
+        along = np.asarray(k.goal) - np.asarray(k.entrance)
+        return np.array([-along[1], along[0]]) / max(np.hypot(*along), 1e-9)
+
+    def _route_to_goal(self, obs: Observation):
+        evasion = self.avoid(obs)
+        if evasion is not None:
+            return evasion
+        return steer_to(self.estimate.pose, self.drop_point, self.params.drive, self.params.arrive)
+
+    def _carry(self, obs: Observation) -> Command:
+        command = self.step(obs)
+        if self.step.status == G.FAILED:  # lost the load on the way: open up and go back for more
+            return self._begin("recover", [G.Release(self.sensors, self.params.gripper)], obs)
+        if self.step.status == G.SUCCEEDED:
+            return self._begin("drop", [G.Lower(self.sensors, self.params.gripper), G.Release(self.sensors, self.params.gripper)], obs)
+        return replace(command, behaviour=self.name)
+
+    def _drop(self, obs: Observation) -> Command:
+        command = self.step(obs)
+        if self.step.status != G.RUNNING:
+            self.knowledge.delivered()
+            self.restart()
+            return self.drive()
+        return replace(command, behaviour=self.name)
+
+    def _recover(self, obs: Observation) -> Command:
+        command = self.step(obs)
+        if self.step.status != G.RUNNING:
+            self.state = "sweep"
+            return self.drive()
+        return replace(command, behaviour=self.name)
+
+
+class ReportProgress(SetController):
+    """Fig. 3-8: return to the entrance and report (Parker's buzzer tune; here a radio broadcast)."""
+    name = REPORT
+
+    def __call__(self, obs: Observation) -> Command:
+        command = self.go(obs, self.knowledge.entrance, self.params.entrance_arrive)
+        if command is not None:
+            return command
+        self.knowledge.reported(obs.time)
+        return self.drive()
+
+
+# Motivation rates (App. A's parameters; the thesis gives none for the cleanup, §1.6 item 7). theta = 1.
+# find: methodical activates after 2 s, wander after 8 s, so a robot with working side IR prefers methodical and
+#   a wander-only robot has heard (radio every 3 s) that a teammate took the task before its own activation.
+# move-spill is shared: every robot may carry loads at once (ch.5's time model divides the moves by n), so a
+#   teammate's claim slows it only briefly (phi) and it never yields to one (psi infinite).
+# report-progress activates within 1 s when due; a teammate's report satisfies it, and one on its way slows it
+#   for phi = 90 s.
+RATES = {
+    METHODICAL: MotivationRates(delta_fast=1 / 2, delta_slow=1 / 300, phi=300.0, psi=300.0, lam=600.0),
+    WANDER: MotivationRates(delta_fast=1 / 8, delta_slow=1 / 300, phi=300.0, psi=300.0, lam=600.0),
+    MOVE: MotivationRates(delta_fast=1 / 3, delta_slow=1 / 30, phi=0.5, psi=math.inf, lam=600.0),
+    REPORT: MotivationRates(delta_fast=1.0, delta_slow=1 / 90, phi=90.0, psi=60.0, lam=180.0),
+}
+
+
+class CleanupRobot:
+    """One R-2's whole controller: beliefs, pose estimate and ALLIANCE over the cleanup behaviour sets.
+
+    ``methodical``: whether the robot has working side IR, so the methodical find is in its repertoire
+    (GRC_RED = A; GRC_BLUE = GRC_GREEN lack it, §3.8.2). The set order is the priority order of ties."""
+
+    def __init__(self, robot: RobotModel, rng: np.random.Generator, params: CleanupParams = CleanupParams(),
+                 methodical: bool = True, alliance: AllianceParams = AllianceParams()):
+        self.knowledge = CleanupKnowledge(params.report_interval)
+        self.estimate = PoseEstimate(robot.drive)
+        bumpers = tuple(name for name in robot.touch if name.startswith("bump_"))
+        avoid = AvoidObstacles(robot.ir_sensors, robot.ir_bearings, bumpers, rng, params.drive)
+        common = (self.knowledge, self.estimate, avoid, params)
+        k = self.knowledge
+        sets = [(METHODICAL, FIND, FindMethodical(robot, *common), lambda obs: not k.located)] if methodical else []
+        sets += [(WANDER, FIND, FindWander(robot, *common), lambda obs: not k.located),
+                 (REPORT, REPORT, ReportProgress(*common), lambda obs: k.report_due(obs.time)),
+                 (MOVE, MOVE, MoveSpill(robot, rng, *common),
+                  lambda obs: k.located and not k.spill_empty and not k.just_delivered)]
+        self.sets = {name: controller for name, _, controller, _ in sets}
+        definitions = [BehaviourSetDefinition(name, applicable, controller, task=task, rates=RATES[name])
+                       for name, task, controller, applicable in sets]
+        self.alliance = AllianceController(robot.name, definitions, alliance)
+        self.active = "idle"
+
+    def __call__(self, obs: Observation) -> Command:
+        k = self.knowledge
+        for message in obs.inbox:
+            k.hear(message.payload)
+        pose = self.estimate.update(obs)
+        if pose is None:
+            return Command(behaviour="idle")
+        if k.home is None:
+            k.home = pose[:2].copy()
+        delivered_last_tick = k.just_delivered
+        command = self.alliance(obs)
+        if delivered_last_tick:  # move-spill's feedback has been down for one tick: it is done with that load
+            k.just_delivered = False
+        if command.behaviour != self.active:
+            if self.active in self.sets:
+                self.sets[self.active].restart()
+            self.active = command.behaviour
+        return replace(command, broadcast={**command.broadcast, **k.message()})

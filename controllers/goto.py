@@ -1,0 +1,105 @@
+"""Going places on a position estimate, under Parker's always-on *avoid-obstacles* layer (Fig. 3-4, §3.8.1).
+
+:class:`AvoidObstacles` is the lowest competence layer of every R-2 behaviour set: when a bump sensor fires or
+an IR sensor sees something closer than ``avoid_range``, it takes over for a short manoeuvre (move off away from
+it, then turn away from the side that sensed it: right when it was dead ahead, a random side when behind), then hands control back. Parker's
+move-spill suppresses it while picking up, so that the robot can drive its jaw around a puck.
+
+:func:`steer_to` is the go-to-point behaviour: turn towards the target on the spot when it is far off the
+heading, else drive at it with a proportional turn, slowing down near it. The thesis gives the behaviours'
+names, not their control laws, so the laws and every constant in :class:`DriveParams` are assumed.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from teamsim.controllers.base import Observation
+from teamsim.positioning import wrap_angle
+
+
+@dataclass(frozen=True)
+class DriveParams:
+    cruise: float = 0.3  # m/s (the R-2's top speed is 0.46 m/s)
+    turn_gain: float = 2.5  # rad/s per rad of heading error
+    turn_rate: float = 1.5  # rad/s, the largest turn rate asked for
+    turn_in_place: float = 0.8  # rad: beyond this heading error the robot turns on the spot
+    slow_radius: float = 0.4  # m: speed ramps down inside this distance of the target
+    avoid_range: float = 0.15  # m: an IR reading nearer than this triggers avoid-obstacles
+    bump_force: float = 1.0  # N on a bumper that counts as a bump
+    back_time: float = 0.8  # s of backing off
+    back_speed: float = 0.15  # m/s
+    turn_time: float = 1.0  # s of turning away afterwards
+
+
+def steer_to(pose: np.ndarray, target, params: DriveParams, arrive: float) -> tuple[float, float] | None:
+    """(v, omega) towards ``target`` from ``pose`` (x, y, heading), or None within ``arrive`` of it."""
+    dx, dy = target[0] - pose[0], target[1] - pose[1]
+    distance = math.hypot(dx, dy)
+    if distance <= arrive:
+        return None
+    error = wrap_angle(math.atan2(dy, dx) - pose[2])
+    omega = float(np.clip(params.turn_gain * error, -params.turn_rate, params.turn_rate))
+    if abs(error) > params.turn_in_place:
+        return 0.0, omega
+    return params.cruise * min(1.0, distance / params.slow_radius) * math.cos(error), omega
+
+
+def turn_to(pose: np.ndarray, heading: float, params: DriveParams, tolerance: float = 0.1) -> float | None:
+    """Turn rate towards ``heading``, or None once within ``tolerance``."""
+    error = wrap_angle(heading - pose[2])
+    if abs(error) <= tolerance:
+        return None
+    return float(np.clip(params.turn_gain * error, -params.turn_rate, params.turn_rate))
+
+
+class AvoidObstacles:
+    """Reactive layer over the IR ring and bumpers: ``__call__`` gives an evasive (v, omega) while a manoeuvre
+    runs, else None. ``ir_sensors`` and ``bumpers`` are the robot's names, in observation order."""
+
+    def __init__(self, ir_sensors: tuple[str, ...], ir_bearings: np.ndarray, bumpers: tuple[str, ...],
+                 rng: np.random.Generator, params: DriveParams = DriveParams()):
+        self.bearings = np.asarray(ir_bearings)
+        self.bumper_bearings = {name: _BUMPER_BEARING[name.rsplit("_", 1)[-1]] for name in bumpers}
+        self.rng = rng
+        self.params = params
+        self.until = -math.inf
+        self.turn = 0.0
+        self.away = 0.0
+        self.back_until = -math.inf
+
+    def __call__(self, obs: Observation) -> tuple[float, float] | None:
+        p = self.params
+        bearing = self._threat(obs)
+        if bearing is not None and obs.time >= self.back_until:
+            ahead = abs(wrap_angle(bearing)) < math.pi / 2
+            self.away = -p.back_speed if ahead else p.back_speed  # move off, away from it
+            self.back_until = obs.time + p.back_time
+            self.until = self.back_until + p.turn_time
+            # Away from the side it is on; from dead ahead, to the right (two robots meeting pass left to left).
+            if abs(math.sin(bearing)) > 0.2:
+                side = -math.copysign(1.0, bearing)
+            else:
+                side = -1.0 if ahead else self.rng.choice((-1.0, 1.0))
+            self.turn = side * p.turn_rate
+        if obs.time < self.back_until:
+            return self.away, 0.0
+        if obs.time < self.until:
+            return 0.0, self.turn
+        return None
+
+    def _threat(self, obs: Observation) -> float | None:
+        """Body-frame bearing of the nearest thing too close, or None."""
+        p = self.params
+        for name, bearing in self.bumper_bearings.items():
+            if obs.touch.get(name, 0.0) >= p.bump_force:
+                return bearing
+        near = np.flatnonzero(obs.ir_range < p.avoid_range)
+        if near.size == 0:
+            return None
+        return float(self.bearings[near[np.argmin(obs.ir_range[near])]])
+
+
+_BUMPER_BEARING = {"front": 0.0, "left": math.pi / 2, "right": -math.pi / 2, "back": math.pi}
