@@ -53,6 +53,13 @@ def _build_parser() -> argparse.ArgumentParser:
     export.add_argument("robot")
     export.add_argument("--out", type=Path, required=True)
 
+    allocate = commands.add_parser("allocate", help="Chand ch.5: fuzzy task allocation (default: the thesis's "
+                                                    "Tables 5.20-5.22)")
+    allocate.add_argument("tasks", nargs="?", type=Path, help="task specification (TOML)")
+    allocate.add_argument("robots", nargs="?", type=Path, help="robot specification (TOML)")
+    allocate.add_argument("--json", action="store_true", help="the same data as JSON")
+    allocate.add_argument("--explain", action="store_true", help="each FIS's inputs, fired rules and output")
+
     study = commands.add_parser("study", help="re-run a thesis's experiments and compare with its figures")
     studies = study.add_subparsers(dest="study", required=True, parser_class=_Parser)
     navigation = studies.add_parser("navigation", help="Chand ch.3: navigation methods x robots x densities")
@@ -75,7 +82,7 @@ def _build_parser() -> argparse.ArgumentParser:
     _sweep_options(lalliance, "the thesis's full sweep (slow)", workers=2, out="renders/study-lalliance")
 
     bench = commands.add_parser("bench", help="benchmarks")
-    bench.add_argument("what", choices=("physics", "render", "nav", "alliance"))
+    bench.add_argument("what", choices=("physics", "render", "nav", "alliance", "allocate"))
     bench.add_argument("--seconds", type=float, default=None, help="simulated seconds per measurement")
     return parser
 
@@ -208,9 +215,20 @@ def cmd_export(args) -> int:
     return 0
 
 
+def cmd_allocate(args) -> int:
+    from teamsim.allocate_cli import cmd_allocate as allocate
+
+    return allocate(args)
+
+
 def cmd_bench(args) -> int:
     from teamsim import bench
 
+    if args.what == "allocate":
+        from teamsim.bench_allocate import bench_allocate
+
+        bench_allocate()
+        return 0
     if args.what == "nav":
         from teamsim.bench_nav import bench_nav
 
@@ -235,7 +253,7 @@ def main(argv: list[str] | None = None) -> int:
     try:
         args = parser.parse_args(argv)
         return {"run": cmd_run, "list": cmd_list, "render": cmd_render, "export": cmd_export,
-                "bench": cmd_bench, "study": cmd_study}[args.command](args)
+                "bench": cmd_bench, "study": cmd_study, "allocate": cmd_allocate}[args.command](args)
     except (UsageError, ConfigError, RenderBackendError) as exc:
         print(f"teamsim: error: {exc}", file=sys.stderr)
         return EXIT_USAGE
