@@ -69,12 +69,12 @@ def _trace_json(trace: Trace) -> dict:
 
 
 def _robot_traces(allocation: Allocation) -> dict:
-    sizes = dict.fromkeys(t.size for t in allocation.tasks.values())
+    sizes = [size for size in dict.fromkeys(t.size for t in allocation.tasks.values()) if size != "any"]
     out = {}
     for robot in allocation.suitability.robots:
         traces: list = []
         capability_scores([robot], "any", traces)
-        for size in sizes.keys() - {"any"}:  # a task that asks for a size: its base size and actuation FISs
+        for size in sizes:  # a task that asks for a size: its base size and actuation FISs
             extra: list = []
             capability_scores([robot], size, extra)
             traces += extra[-2:]
