@@ -45,6 +45,7 @@ from teamsim.models.robot import RobotModel
 FIND, MOVE, REPORT = "find-locations", "move-spill", "report-progress"
 METHODICAL, WANDER = "find-locations-methodical", "find-locations-wander"
 RIGHT_SIDE_IR = ("ir_right_front", "ir_right_rear")
+JAW_AHEAD = 0.13  # m from the R-2's axle to the middle of its jaw
 
 
 @dataclass(frozen=True)
@@ -61,9 +62,12 @@ class CleanupParams:
     spill_vicinity: float = 1.0  # m from the believed spill centre where sweeping starts
     spill_radius: float = 0.6  # m: sweep lines pass within this of the believed spill centre
     sweep_overshoot: float = 0.6  # m a sweep line runs past its random point
-    sweep_speed: float = 0.15  # m/s while scanning: 1.5 cm per control period
-    empty_lines: int = 12  # consecutive sweep lines without a puck: the spill is gone
+    sweep_speed: float = 0.2  # m/s while scanning: 2 cm per control period
+    widen_every: int = 4  # empty sweep lines
+    hint_lines: int = 4  # empty sweep lines around where it last had a puck before it searches the spill again
+    empty_lines: int = 16  # consecutive sweep lines without a puck: the spill is gone
     goal_spread: float = 0.25  # m: deliveries land this far either side of the believed goal
+    goal_keepout: float = 1.5  # m: pucks this near the believed goal are never searched for (they are moved)
     goal_clearance: float = 0.45  # m: the drop point stands this far in from the goal-side extent
     arrive: float = 0.2  # m: a waypoint is reached within this
     lane_offset: float = 0.5  # m to the right of the direct line while travelling (keep right)
@@ -108,6 +112,7 @@ class CleanupKnowledge:
     delivered_since_report: bool = False
     just_delivered: bool = False
     spill_empty: bool = False
+    hint: tuple | None = None  # where this robot last had a puck: the next search starts there
     transports: int = 0
     reports: int = 0
 
@@ -295,7 +300,7 @@ class MoveSpill(SetController):
         return handler(obs)
 
     def _to_spill(self, obs: Observation) -> Command:
-        command = self.go(obs, self.knowledge.spill, self.params.spill_vicinity)
+        command = self.go(obs, self._search_centre(), self.params.spill_vicinity)
         if command is not None:
             return command
         self.state = "sweep"
@@ -305,7 +310,7 @@ class MoveSpill(SetController):
         """"Wander in a straight line" through the spill area (Fig. 3-7 step 2): face a random point of it,
         then drive straight past it, scanning with the fingertip IR; avoid-obstacles is off."""
         p = self.params
-        if np.hypot(*(self.estimate.pose[:2] - self.knowledge.spill)) > p.spill_vicinity + p.spill_radius:
+        if np.hypot(*(self.estimate.pose[:2] - self._search_centre())) > p.spill_vicinity + p.spill_radius:
             self.state, self.line = "to_spill", None  # a failed pick-up can leave it far off
             return self._to_spill(obs)
         if self.line is None:
@@ -319,24 +324,26 @@ class MoveSpill(SetController):
             return self.drive()
         seen = np.isfinite(obs.ir_range[[self.sensors.tip_left, self.sensors.tip_right]]).any()
         if seen or any(self.sensors.beams(obs)):  # ahead of the jaw, or already in it
-            self.empty_lines = 0
             self.line = None
             g = self.sensors, self.params.gripper
             return self._begin("pick", [G.Approach(*g), G.Grasp(*g), G.Lift(*g)], obs)
         if obs.time - scanning_since > length / p.sweep_speed:
             self.line = None
             self.empty_lines += 1
-            if self.empty_lines >= p.empty_lines:
+            if self.knowledge.hint is not None and self.empty_lines >= p.hint_lines:
+                self.knowledge.hint, self.empty_lines = None, 0  # nothing left there: back to the spill
+            elif self.empty_lines >= p.empty_lines:
                 self.knowledge.spill_empty = True
             return self.drive(-p.sweep_speed)
         return self.drive(p.sweep_speed)
 
     def _new_line(self) -> tuple:
-        """(heading, length, None): through a random point within ``spill_radius`` of the believed spill
-        centre, and ``sweep_overshoot`` beyond it."""
+        """(heading, length, None): through a random point near the search centre, and ``sweep_overshoot``
+        beyond it. The area widens by ``spill_radius`` every ``widen_every`` lines that find nothing."""
         p = self.params
-        radius, bearing = p.spill_radius * math.sqrt(self.rng.random()), self.rng.uniform(-math.pi, math.pi)
-        point = np.asarray(self.knowledge.spill) + radius * np.array([math.cos(bearing), math.sin(bearing)])
+        reach = p.spill_radius * (1.0 + self.empty_lines / p.widen_every)  # pucks get pushed about: widen the search
+        radius, bearing = reach * math.sqrt(self.rng.random()), self.rng.uniform(-math.pi, math.pi)
+        point = np.asarray(self._search_centre()) + radius * np.array([math.cos(bearing), math.sin(bearing)])
         dx, dy = point - self.estimate.pose[:2]
         return math.atan2(dy, dx), math.hypot(dx, dy) + p.sweep_overshoot, None
 
@@ -350,12 +357,18 @@ class MoveSpill(SetController):
             return self._begin("recover", [G.Release(self.sensors, self.params.gripper)], obs)
         if self.step.status == G.SUCCEEDED:
             # Pucks get pushed about: look for the next one where this one was (the jaw is ahead of the pose).
-            x, y, heading = self.estimate.pose
-            self.knowledge.spill = (x + 0.13 * math.cos(heading), y + 0.13 * math.sin(heading))
+            self.knowledge.hint = self._jaw_position()
             goal = np.asarray(self.knowledge.goal)
             self.drop_point = tuple(goal + self._across_goal() * self.rng.uniform(-1, 1) * self.params.goal_spread)
             return self._begin("carry", [G.Carry(self.sensors, self._route_to_goal, self.params.gripper)], obs)
         return replace(command, behaviour=self.name)
+
+    def _jaw_position(self) -> tuple[float, float]:
+        x, y, heading = self.estimate.pose
+        return x + JAW_AHEAD * math.cos(heading), y + JAW_AHEAD * math.sin(heading)
+
+    def _search_centre(self) -> tuple:
+        return self.knowledge.hint or self.knowledge.spill
 
     def _across_goal(self) -> np.ndarray:
         """Unit vector along the goal wall (across the room's long axis)."""
@@ -371,7 +384,10 @@ class MoveSpill(SetController):
 
     def _carry(self, obs: Observation) -> Command:
         command = self.step(obs)
-        if self.step.status == G.FAILED:  # lost the load on the way: open up and go back for more
+        if self.step.status == G.FAILED:  # lost the load on the way: open up and look for it here
+            lost_at = self._jaw_position()
+            if np.hypot(*(np.subtract(lost_at, self.knowledge.goal))) > self.params.goal_keepout:
+                self.knowledge.hint = lost_at  # (near the goal it is as good as delivered: leave it)
             return self._begin("recover", [G.Release(self.sensors, self.params.gripper)], obs)
         if self.step.status == G.SUCCEEDED:
             return self._begin("drop", [G.Lower(self.sensors, self.params.gripper), G.Release(self.sensors, self.params.gripper)], obs)

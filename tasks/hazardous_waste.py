@@ -10,8 +10,8 @@ find in its repertoire (§3.8.2).
 
 It completes when ``completion`` of the pucks (8 of 10) lie in the goal zone, after any report the delivering
 robot then makes (ch.5: "if the robot delivering the 8th puck decides to report, completion waits for that
-report"). The goal zone, drawn on the floor, is the back metre of the room across its middle 1.6 m: the thesis
-gives no size. Measures: time; energy by Parker's count (a unit per second while any motor runs) and as
+report"). The goal zone, drawn on the floor, is the back sixth of the room across the middle half of its width:
+the thesis gives no size. Measures: time; energy by Parker's count (a unit per second while any motor runs) and as
 mechanical work; transports, pucks per transport, reports and reports per move; who ran find-locations.
 """
 from __future__ import annotations
@@ -34,7 +34,9 @@ ROOM = (26 * FOOT, 12 * FOOT)  # Parker §2.2.3: the 26 x 12 ft work area
 TEAMS = {2: ("red", "green"), 3: ("red", "blue", "green")}
 SIDE_IR_WORKS = ("red",)  # §3.8.1: blue's and green's side IR are dysfunctional
 SIDE_IR = "ir_left+ir_right"  # the blind-ir fault's sensor prefixes for the side sensors
-GOAL_DEPTH, GOAL_WIDTH = 1.0, 1.6  # m: the goal zone (assumed)
+# The goal zone (the thesis gives no size): the back sixth of the room's length (as deep as the spill's centre
+# lies from the entrance) across the middle half of its width.
+GOAL_DEPTH, GOAL_WIDTH = ROOM[0] / 6, ROOM[1] / 2
 START_X = 0.75  # m from the west wall: clear of a robot following that wall
 START_GAP = 0.6  # m between robots at the start, across the entrance
 
@@ -59,6 +61,7 @@ class HazardousWasteMission:
     summary = "Parker's cleanup: R-2s find a puck spill, carry it to the goal and report, under ALLIANCE"
     Params = HazardousWasteParams
     default_duration = 1800.0
+    video_speedup = 4.0  # a mission takes minutes: its video plays four simulated seconds a second
 
     def build(self, params: HazardousWasteParams, rng: np.random.Generator, newcomers, physics_dt: float) -> Scene:
         length, width = ROOM

@@ -81,6 +81,14 @@ def _build_parser() -> argparse.ArgumentParser:
     lalliance.add_argument("--runs", type=_positive_int("--runs"), help="runs per scenario")
     _sweep_options(lalliance, "the thesis's full sweep (slow)", workers=2, out="renders/study-lalliance")
 
+    awareness = studies.add_parser("awareness", help="Parker ch.5: hazardous waste with and without awareness, "
+                                                     "2 and 3 robots (versions I-IV)")
+    awareness.add_argument("--missions", type=_positive_int("--missions"), default=10, help="missions per version")
+    awareness.add_argument("--duration", type=float, help="simulated seconds per mission (mission default if unset)")
+    awareness.add_argument("--workers", type=_positive_int("--workers"), default=2)
+    awareness.add_argument("--seed", type=int, default=0)
+    awareness.add_argument("--out", type=Path, default=Path("renders/study-awareness"))
+
     bench = commands.add_parser("bench", help="benchmarks")
     bench.add_argument("what", choices=("physics", "render", "nav", "alliance", "allocate"))
     bench.add_argument("--seconds", type=float, default=None, help="simulated seconds per measurement")
@@ -134,6 +142,14 @@ def cmd_study(args) -> int:
         written = run_study(plan(args.full, args.trials, args.seed), args.out, args.workers)
         print(f"wrote {written['report']} and {written['results']} ({written['rows']} plans, "
               f"{written['wall_s']:.0f} s)")
+    elif args.study == "awareness":
+        from teamsim.tasks.awareness_study import AwarenessStudy, run_study
+
+        if args.duration is not None and not args.duration > 0:
+            raise ConfigError("--duration: must be > 0 simulated seconds")
+        out = run_study(AwarenessStudy(missions=args.missions, seed=args.seed, workers=args.workers, out=args.out,
+                                       duration=args.duration))
+        print(f"wrote {out / 'report.md'} and {out / 'results.csv'}")
     elif args.study == "lalliance":
         from teamsim.tasks.lalliance_study import run_study
 

@@ -88,10 +88,11 @@ class EventLog:
 class TrajectoryRecorder:
     """Keeps the scene state at each video frame; a frame is a few hundred bytes of qpos, not pixels."""
 
-    def __init__(self, xml: str, robot_names: list[str], fps: int, physics_dt: float):
+    def __init__(self, xml: str, robot_names: list[str], fps: int, physics_dt: float, speedup: float = 1.0):
         self.xml = xml
         self.robot_names = robot_names
-        self.fps = fps
+        self.fps = fps  # frames per second of video
+        self.speedup = speedup  # simulated seconds per second of video
         self.physics_dt = physics_dt
         self.times: list[float] = []
         self.qpos: list[np.ndarray] = []
@@ -99,7 +100,7 @@ class TrajectoryRecorder:
 
     def step_of_frame(self, frame: int) -> int:
         """The physics step at which frame ``frame`` is taken (frames sit on the nearest physics step)."""
-        return round(frame / self.fps / self.physics_dt)
+        return round(frame * self.speedup / self.fps / self.physics_dt)
 
     @property
     def next_step(self) -> int:
@@ -119,6 +120,7 @@ class TrajectoryRecorder:
         buffer = io.BytesIO()
         np.savez_compressed(
             buffer, model_xml=np.array(self.xml), robot_names=np.array(self.robot_names), fps=np.array(self.fps),
+            speedup=np.array(self.speedup),
             time=np.array(self.times), qpos=np.array(self.qpos).reshape(len(self.times), -1),
             behaviour=self.behaviour_array(), **(extra or {}))
         write_atomic(path, buffer.getvalue())
