@@ -33,6 +33,7 @@ class Scene:
     params: Any = None  # the mission parameters it was built from
     info: dict = field(default_factory=dict)  # whatever else the mission needs later (goal, known map, ...)
     faults: list = field(default_factory=list)  # teamsim.faults.Fault the scenario starts with (a dead sensor, ...)
+    scenario: Any = None  # the teamsim.scenario.Scenario it was built from, if the mission describes worlds so
 
 
 class Mission(Protocol):
@@ -53,3 +54,19 @@ class Mission(Protocol):
 
     def outcome(self, world: Any) -> tuple[bool, dict]:
         """(completed, metrics) measured from the world at the end of the trial."""
+
+
+class ScenarioMission:
+    """A mission whose worlds are scenarios (``teamsim.scenario``): ``scenario`` describes the world its
+    parameters give, ``scene`` builds a described world, and ``build`` is the two in turn, so a run from the
+    parameters and a run from the exported scenario are the same trial. ``Task`` and ``Controller`` are the
+    classes of the scenario's ``task`` section and of each robot's ``controller`` settings.
+
+    Subclasses provide ``scenario(params, rng, newcomers) -> Scenario`` and ``scene(scenario, newcomers,
+    physics_dt) -> Scene`` (``teamsim.scenario.scene_of`` builds the common part)."""
+    Task: ClassVar[type]
+    Controller: ClassVar[type]
+
+    def build(self, params: Any, rng: np.random.Generator, newcomers: list[tuple[str, str]],
+              physics_dt: float) -> Scene:
+        return self.scene(self.scenario(params, rng, newcomers), newcomers, physics_dt)

@@ -9,6 +9,7 @@ travelled), AV (average velocity over v_gmax) and success.
 """
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass
 
@@ -18,10 +19,12 @@ from teamsim.config import ConfigError, setting
 from teamsim.controllers import dynamic_window as dw
 from teamsim.controllers.astar import PlannerParams, plan_on_grid
 from teamsim.models import ROBOT_KINDS
-from teamsim.models.arenas import walled_room
+from teamsim.models.arenas import Box
 from teamsim.models.robot import RobotModel, TricycleSpec
-from teamsim.tasks.base import RobotSlot, Scene
-from teamsim.tasks.nav_worlds import NavWorldParams, random_world
+from teamsim.scenario import (MAX_EXTENT, Arena, BoxObstacle, RobotEntry, Scenario, image_boxes, obstacles,
+                              scene_of)
+from teamsim.tasks.base import Scene, ScenarioMission
+from teamsim.tasks.nav_worlds import NavWorld, NavWorldParams, random_world
 
 # Table 3.1's simulated robots: kind and the dimensions that differ from the kind's defaults.
 TABLE_3_1 = {
@@ -55,27 +58,67 @@ class NavigateParams:
             raise ConfigError(f"robot={self.robot}: navigate drives {', '.join(NAV_KINDS)} (or A, B, C)")
 
 
-class NavigateMission:
+@dataclass
+class NavigateTask:
+    """navigate's own scenario settings."""
+    goal: tuple[float, float] = setting((0.0, 0.0), lo=-MAX_EXTENT, hi=MAX_EXTENT, meaning="goal x, y, m")
+    time_limit: float = setting(450.0, lo=0.0, open_lo=True, hi=1e7,
+                                meaning="s; the trial ends then (§3.6.2: 300 s at 5 and 10 % density, 450 s above)")
+    map_resolution: float = setting(0.1, lo=0.01, hi=1.0,
+                                    meaning="m per cell of the known map (HRDK, path index) and the density raster")
+
+
+@dataclass
+class NavigationSettings:
+    """The navigating robot's controller."""
+    method: str = setting("FRC", choices=tuple(METHODS), meaning="navigation method (§3.6.2)")
+
+
+class NavigateMission(ScenarioMission):
     name = "navigate"
     summary = "one robot crosses a random obstacle world corner to corner (Chand §3.6)"
     Params = NavigateParams
+    Task = NavigateTask
+    Controller = NavigationSettings
     default_duration = 450.0
 
-    def build(self, params: NavigateParams, rng: np.random.Generator, newcomers, physics_dt: float) -> Scene:
+    def scenario(self, params: NavigateParams, rng: np.random.Generator, newcomers) -> Scenario:
         if params.world_seed >= 0:
             rng = np.random.default_rng(params.world_seed)
         world = random_world(params.density, rng, NavWorldParams())
         kind, options = robot_of(params.robot)
-        x, y, heading = world.start
-        arena = walled_room(world.size, world.size, obstacles=world.boxes, physics_dt=physics_dt)
-        arena.worldbody.add("site", name="goal", pos=[*world.goal, 0.01], size=[0.3, 0.005], type="cylinder",
-                            rgba=[0.1, 0.8, 0.2, 0.6])
-        slot = RobotSlot("red", kind, x, y, heading, options=options)
-        return Scene(arena=arena, robots=[slot], params=params,
-                     info={"nav_world": world, "time_limit": time_limit(params.density)})
+        boxes = [BoxObstacle(**dataclasses.asdict(box)) for box in world.boxes]
+        return Scenario(mission=self.name, arena=Arena(size=(world.size, world.size), boxes=boxes),
+                        robots={"red": RobotEntry(kind, world.start, dict(options),
+                                                  NavigationSettings(params.controller))},
+                        task=NavigateTask(world.goal, time_limit(params.density), world.resolution))
+
+    def check_scenario(self, scenario: Scenario) -> None:
+        """One robot of a navigating kind, in a square arena (Chand's worlds are square), with the goal inside."""
+        robots = scenario.robots
+        if len(robots) != 1:
+            raise ConfigError(f"robots: navigate drives exactly one robot; got {len(robots)} ({', '.join(robots)})")
+        (name, robot), = robots.items()
+        if robot.kind not in NAV_KINDS:
+            raise ConfigError(f"robots.{name}.kind={robot.kind!r}: navigate drives {', '.join(NAV_KINDS)}")
+        sx, sy = scenario.arena.size
+        if sx != sy:
+            raise ConfigError(f"arena.size=[{sx:g}, {sy:g}]: navigate's worlds are square; allowed: equal sides")
+        if max(map(abs, scenario.task.goal)) > sx / 2:
+            raise ConfigError(f"task.goal={list(scenario.task.goal)}: must lie inside the arena, "
+                              f"x and y in [{-sx / 2:g}, {sx / 2:g}]")
+
+    def scene(self, scenario: Scenario, newcomers, physics_dt: float) -> Scene:
+        scene = scene_of(scenario, newcomers, physics_dt)
+        goal = scenario.task.goal
+        scene.arena.worldbody.add("site", name="goal", pos=[*goal, 0.01], size=[0.3, 0.005], type="cylinder",
+                                  rgba=[0.1, 0.8, 0.2, 0.6])
+        name = next(iter(scenario.robots))
+        scene.info.update(nav_world=nav_world_of(scenario), time_limit=scenario.task.time_limit, robot=name)
+        return scene
 
     def controller(self, robot: RobotModel, scene: Scene, rng: np.random.Generator):
-        params, world = scene.params, scene.info["nav_world"]
+        settings, world = scene.scenario.robots[robot.name].controller, scene.info["nav_world"]
         offset = 0.0
         kwargs = {}
         if isinstance(robot.drive, TricycleSpec):
@@ -85,11 +128,11 @@ class NavigateMission:
         # The pentagon's and the rectangle's sensors sit on their sides, nearer the centre than the enclosing
         # circle (by up to 19 % of its radius on the pentagon, 37 % on Robot C's rectangle).
         kwargs["sensor_radius"] = ir_sensor_radii(robot, offset)
-        if params.controller == "HRDK":
+        if settings.method == "HRDK":
             kwargs["known_map"] = world.known_map()
-        elif params.controller == "HRDU":
+        elif settings.method == "HRDU":
             kwargs["grid"] = world.unexplored_map()
-        controller = METHODS[params.controller](robot.limits, robot.kind, robot.footprint_radius, world.goal,
+        controller = METHODS[settings.method](robot.limits, robot.kind, robot.footprint_radius, world.goal,
                                                 **kwargs)
         scene.info["controller"] = controller
         return controller
@@ -103,10 +146,11 @@ class NavigateMission:
 
     def outcome(self, world) -> tuple[bool, dict]:
         nav_world = world.scene.info["nav_world"]
-        robot = world.robots["red"]
+        name = world.scene.info["robot"]
+        robot = world.robots[name]
         x, y, _ = world.pose(robot)
         reached = self._arrived(world) and math.dist((x, y), nav_world.goal) <= 0.5 + robot.model.footprint_radius
-        travelled = float(world.odometry()["red"])
+        travelled = float(world.odometry()[name])
         planned = optimal_path_length(nav_world, robot.model.footprint_radius)
         nav_time = world.time
         v_max = robot.model.limits.v_max
@@ -121,6 +165,22 @@ class NavigateMission:
             "final_distance_to_goal": round(math.dist((x, y), nav_world.goal), 3),
         }
         return reached, metrics
+
+
+def nav_world_of(scenario: Scenario) -> NavWorld:
+    """The navigation world of a scenario: its obstacles (boxes, image, cylinders) rasterised at the task's map
+    resolution (a cell is occupied when its centre lies in an obstacle, as ``random_world`` measures density),
+    the robot's start and the goal."""
+    size, resolution = scenario.arena.size[0], scenario.task.map_resolution
+    cells = round(size / resolution)
+    centres = -size / 2 + (np.arange(cells) + 0.5) * resolution
+    occupancy = np.zeros((cells, cells), bool)
+    for obstacle in obstacles(scenario.arena):
+        occupancy |= obstacle.distance(centres[None, :], centres[:, None]) <= 0
+    boxes = [*scenario.arena.boxes, *(b for b, _ in image_boxes(scenario.arena))]
+    robot = next(iter(scenario.robots.values()))
+    return NavWorld(tuple(Box(**dataclasses.asdict(b)) for b in boxes), occupancy, (-size / 2, -size / 2),
+                    resolution, size, robot.pose, scenario.task.goal)
 
 
 def ir_sensor_radii(robot: RobotModel, centre_offset: float) -> np.ndarray:

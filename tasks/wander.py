@@ -12,9 +12,9 @@ import numpy as np
 from teamsim.config import ConfigError, setting
 from teamsim.controllers.wander import WanderController, WanderParams as BehaviourParams
 from teamsim.models import ROBOT_KINDS
-from teamsim.models.arenas import Box, walled_room
 from teamsim.models.robot import RobotModel, team_names
-from teamsim.tasks.base import RobotSlot, Scene
+from teamsim.scenario import Arena, BoxObstacle, RobotEntry, Scenario, scene_of
+from teamsim.tasks.base import Scene, ScenarioMission
 
 CELL = 1.6  # m; spawn grid pitch, wide enough for the largest robot (0.6 m enclosing radius) plus clearance
 
@@ -40,15 +40,24 @@ class WanderParams:
                               f"{cells} robots and obstacles together; raise room_size")
 
 
-class WanderMission:
+@dataclass
+class WanderTask:
+    """wander has no settings of its own in a scenario: the trial is the room, the team and the time."""
+
+
+class WanderMission(ScenarioMission):
     name = "wander"
     summary = "N robots (differential-drive by default) wander with IR obstacle avoidance in a walled room"
     Params = WanderParams
+    Task = WanderTask
+    Controller = BehaviourParams  # each robot's wander settings, scaled to its drive and IR range when it starts
     default_duration = 60.0
 
-    def build(self, params: WanderParams, rng: np.random.Generator, newcomers: list[tuple[str, str]],
-              physics_dt: float) -> Scene:
+    def scenario(self, params: WanderParams, rng: np.random.Generator, newcomers: list[tuple[str, str]]) -> Scenario:
         team = [(name, params.kind) for name in team_names(params.robots)]
+        taken = [name for name, _ in newcomers if name in dict(team)]
+        if taken:
+            raise ConfigError(f"--fault add-robot:{taken[0]}: robot {taken[0]!r} is already in the team")
         side = params.side(len(team) + len(newcomers))
         per_row = int(side / CELL)
         offset = -side / 2 + (side - per_row * CELL) / 2 + CELL / 2
@@ -58,16 +67,20 @@ class WanderMission:
             raise ConfigError(f"wander: {needed} robots and obstacles do not fit a {side:g} m room; raise room_size")
         order = rng.permutation(len(cells))[:needed]
         chosen = [cells[k] for k in order]
-        obstacles = tuple(Box(x, y, *rng.uniform(0.15, 0.45, size=2), yaw=float(rng.uniform(0, math.pi)))
-                          for x, y in chosen[:params.obstacles])
-        slots = [RobotSlot(name, kind, x, y, float(rng.uniform(-math.pi, math.pi)), dormant=k >= len(team))
-                 for k, ((name, kind), (x, y)) in enumerate(zip(team + newcomers, chosen[params.obstacles:]))]
-        arena = walled_room(side, side, obstacles=obstacles, physics_dt=physics_dt)
-        return Scene(arena=arena, robots=slots, params=params)
+        obstacles = [BoxObstacle(x, y, *rng.uniform(0.15, 0.45, size=2), yaw=float(rng.uniform(0, math.pi)))
+                     for x, y in chosen[:params.obstacles]]
+        robots = {name: RobotEntry(kind, (x, y, float(rng.uniform(-math.pi, math.pi))), controller=BehaviourParams())
+                  for (name, kind), (x, y) in zip(team + newcomers, chosen[params.obstacles:])}
+        return Scenario(mission=self.name, arena=Arena(size=(side, side), boxes=obstacles), robots=robots,
+                        task=WanderTask())
+
+    def scene(self, scenario: Scenario, newcomers: list[tuple[str, str]], physics_dt: float) -> Scene:
+        return scene_of(scenario, newcomers, physics_dt)
 
     def controller(self, robot: RobotModel, scene: Scene, rng: np.random.Generator):
         limits = robot.limits
-        behaviour = BehaviourParams().for_robot(limits.v_max, limits.omega_max, robot.ir.max_range)
+        settings = scene.scenario.robots[robot.name].controller
+        behaviour = settings.for_robot(limits.v_max, limits.omega_max, robot.ir.max_range)
         return WanderController(robot.ir_bearings, rng, behaviour)
 
     def done(self, world) -> bool:

@@ -30,17 +30,19 @@ def _build_parser() -> argparse.ArgumentParser:
     commands.add_parser("list", help="robots, missions and studies")
 
     run = commands.add_parser("run", help="run one trial of a mission")
-    run.add_argument("mission")
-    run.add_argument("--seed", type=int, default=0)
-    run.add_argument("--duration", type=float, help="simulated seconds (default: the mission's)")
+    _trial_arguments(run)
     run.add_argument("--video", action="store_true", help="write video.mp4 (H.264)")
     run.add_argument("--camera", default="top", help="'top' or a robot name for its tracking camera")
     run.add_argument("--out", default="renders", help="output root (default: renders)")
     run.add_argument("--run-id", help="run folder name (default: seed and timestamp)")
-    run.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
-                     help="mission parameter (robots=5) or group.key (radio.loss=0.2)")
-    run.add_argument("--fault", action="append", default=[], metavar="SPEC",
-                     help=f"{SPEC_FORM}; kinds: {', '.join(FAULT_KINDS)}")
+
+    scenario = commands.add_parser("scenario", help="scenario files: a world, a team and its faults in one YAML "
+                                                    "file (docs/scenarios.md)")
+    scenario_commands = scenario.add_subparsers(dest="scenario_command", required=True, parser_class=_Parser)
+    show = scenario_commands.add_parser("show", help="print the exact scenario a run would use")
+    _trial_arguments(show)
+    show.add_argument("--output", type=Path, metavar="FILE", help="write it to FILE instead")
+    show.set_defaults(video=False, camera="top", out="renders", run_id=None)
 
     render = commands.add_parser("render", help="re-render a run's video from its trajectory.npz")
     render.add_argument("run_dir", type=Path)
@@ -93,6 +95,19 @@ def _build_parser() -> argparse.ArgumentParser:
     bench.add_argument("what", choices=("physics", "render", "nav", "alliance", "allocate"))
     bench.add_argument("--seconds", type=float, default=None, help="simulated seconds per measurement")
     return parser
+
+
+def _trial_arguments(parser: argparse.ArgumentParser) -> None:
+    """What defines a trial, for `run` and `scenario show` (precedence: teamsim/scenario_cli.py)."""
+    parser.add_argument("mission")
+    parser.add_argument("--scenario", type=Path, metavar="FILE", help="scenario file (YAML) to run")
+    parser.add_argument("--seed", type=int, help="trial seed (default: the scenario's, else 0)")
+    parser.add_argument("--duration", type=float, help="simulated seconds (default: the scenario's or mission's)")
+    parser.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
+                        help="mission parameter (robots=5), group.key (radio.loss=0.2) or any scenario field by "
+                             "its dotted path (robots.red.pose=[1,2,0])")
+    parser.add_argument("--fault", action="append", default=[], metavar="SPEC",
+                        help=f"{SPEC_FORM}; kinds: {', '.join(FAULT_KINDS)}")
 
 
 def _sweep_options(parser: argparse.ArgumentParser, full_help: str, workers: int, out: str) -> None:
@@ -161,17 +176,32 @@ def cmd_study(args) -> int:
 
 def _trial_config(args) -> TrialConfig:
     from teamsim.runner import mission_of
+    from teamsim.scenario import supports
+    from teamsim.scenario_cli import scenario_config
 
     mission = mission_of(args.mission)
-    config = TrialConfig(mission=args.mission, params=mission.Params(), seed=args.seed, duration=args.duration,
+    config = TrialConfig(mission=args.mission, params=mission.Params(), seed=args.seed or 0, duration=args.duration,
                          out=args.out, run_id=args.run_id)
     config.video.enabled = args.video
     config.video.camera = args.camera
+    if args.scenario or supports(mission):
+        return scenario_config(args, mission, config)
     for assignment in args.set:
         apply_setting(config, assignment)
     config.faults = [parse_fault(spec) for spec in args.fault]
     validate(config)
     return config
+
+
+def cmd_scenario(args) -> int:
+    from teamsim.runner import mission_of
+    from teamsim.scenario import not_supported, supports
+    from teamsim.scenario_cli import show
+
+    mission = mission_of(args.mission)
+    if not supports(mission):
+        raise not_supported(mission)
+    return show(args, mission, _trial_config(args))
 
 
 def cmd_run(args) -> int:
@@ -269,7 +299,8 @@ def main(argv: list[str] | None = None) -> int:
     try:
         args = parser.parse_args(argv)
         return {"run": cmd_run, "list": cmd_list, "render": cmd_render, "export": cmd_export,
-                "bench": cmd_bench, "study": cmd_study, "allocate": cmd_allocate}[args.command](args)
+                "bench": cmd_bench, "study": cmd_study, "allocate": cmd_allocate,
+                "scenario": cmd_scenario}[args.command](args)
     except (UsageError, ConfigError, RenderBackendError) as exc:
         print(f"teamsim: error: {exc}", file=sys.stderr)
         return EXIT_USAGE

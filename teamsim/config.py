@@ -86,9 +86,13 @@ class TrialConfig:
     positioning: PositioningConfig = field(default_factory=PositioningConfig)
     video: VideoConfig = field(default_factory=VideoConfig)
     faults: list = field(default_factory=list)
+    # The world a scenario describes (teamsim.scenario.Scenario: arena, objects, team, task; its faults are in
+    # ``faults``), or None: the mission builds its world from ``params``.
+    scenario: Any = None
 
 
-def _check_value(name: str, value: Any, meta: dict) -> None:
+def check_value(name: str, value: Any, meta: dict) -> None:
+    """Check one value against a field's bounds and choices (ConfigError naming ``name``)."""
     if meta.get("choices") and value not in meta["choices"]:
         raise ConfigError(f"{name}={value!r}: allowed values are {', '.join(map(str, meta['choices']))}")
     if isinstance(value, bool) or not isinstance(value, (int, float)):
@@ -112,7 +116,7 @@ def validate(obj: Any, prefix: str = "") -> None:
         if dataclasses.is_dataclass(value):
             validate(value, "" if f.name == "params" else name + ".")
         elif value is not None:
-            _check_value(name, value, f.metadata)
+            check_value(name, value, f.metadata)
     post = getattr(obj, "check", None)
     if callable(post):
         post()
@@ -165,5 +169,5 @@ def apply_setting(cfg: TrialConfig, assignment: str) -> None:
                           f"allowed: {', '.join(settable_keys(cfg))}")
     kind = typing.get_type_hints(type(target))[leaf]
     value = _parse_scalar(key, text.strip(), kind)
-    _check_value(key, value, fields[leaf].metadata)
+    check_value(key, value, fields[leaf].metadata)
     setattr(target, leaf, value)

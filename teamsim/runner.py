@@ -22,6 +22,7 @@ import teamsim
 from teamsim.config import ConfigError, TrialConfig, validate
 from teamsim.progress import Progress
 from teamsim.recording import EventLog, MotivationRecorder, TrajectoryRecorder, write_json
+from teamsim.scenario import resolve, scenario_of, to_data
 from teamsim.tasks import MISSIONS
 from teamsim.timeline import write_timeline
 from teamsim.world import PhysicsUnstable, World
@@ -100,6 +101,7 @@ def run_trial(config: TrialConfig, seed: int | None = None, progress: bool | Non
         config = dataclasses.replace(config, seed=seed)
     validate(config)
     mission = mission_of(config.mission)
+    config = resolve(config, mission)  # the mission's world as a scenario, if it describes its worlds so
     duration = config.duration or mission.default_duration
     world = World(config, mission)
     renderer = writer = None
@@ -113,7 +115,9 @@ def run_trial(config: TrialConfig, seed: int | None = None, progress: bool | Non
     run_dir = make_run_dir(config)
     summary = {"mission": config.mission, "seed": config.seed, "run_id": run_dir.name, "status": "running",
                "completed": False, "duration_s": duration, "teamsim": teamsim.__version__,
-               "mujoco": mujoco.__version__, "config": dataclasses.asdict(config)}
+               "mujoco": mujoco.__version__,
+               "config": {k: v for k, v in dataclasses.asdict(config).items() if k != "scenario"},
+               "scenario": to_data(scenario_of(config, mission)) if config.scenario is not None else None}
     write_json(run_dir / "summary.json", summary)
     events = EventLog(run_dir / "events.jsonl")
     world.record = events

@@ -106,7 +106,10 @@ class World:
         self.steps_per_energy = max(1, round(timing.energy_dt / timing.physics_dt))
 
         newcomers = [(f.robot, f.options["kind"]) for f in config.faults if f.kind == "add-robot"]
-        scene = mission.build(config.params, self.streams.get("mission", "layout"), newcomers, timing.physics_dt)
+        if config.scenario is not None:  # a described world (teamsim.scenario)
+            scene = mission.scene(config.scenario, newcomers, timing.physics_dt)
+        else:
+            scene = mission.build(config.params, self.streams.get("mission", "layout"), newcomers, timing.physics_dt)
         self.robots: dict[str, Robot] = {}
         for slot in scene.robots:
             if slot.name in self.robots:
@@ -135,7 +138,10 @@ class World:
         self.check_faults(faults)
         self.faults = sorted(faults, key=lambda f: f.time)
         self.xml = scene.arena.to_xml_string()
-        self.model = mujoco.MjModel.from_xml_string(self.xml, scene.arena.get_assets())
+        try:
+            self.model = mujoco.MjModel.from_xml_string(self.xml, scene.arena.get_assets())
+        except ValueError as exc:  # e.g. robot options whose parts do not fit together
+            raise ConfigError(f"the scene does not compile: {' '.join(str(exc).split())}") from None
         self.data = mujoco.MjData(self.model)
         self.model.opt.disableflags |= _SENSOR_STAGE
         self._index_model()
