@@ -445,9 +445,14 @@ def image_boxes(arena: Arena) -> list[tuple[BoxObstacle, str]]:
         return []
     import cv2  # noqa: PLC0415  (OpenCV only when a scenario has an image)
 
-    pixels = cv2.imread(image.file, cv2.IMREAD_GRAYSCALE)
+    try:
+        encoded = np.frombuffer(Path(image.file).read_bytes(), np.uint8)
+    except OSError as exc:
+        raise ConfigError(f"arena.image.file={image.file!r}: cannot read ({exc.strerror or exc})") from None
+    # (decoding from memory: cv2.imread would also print its own warning on a bad file)
+    pixels = cv2.imdecode(encoded, cv2.IMREAD_GRAYSCALE) if encoded.size else None
     if pixels is None:
-        raise ConfigError(f"arena.image.file={image.file!r}: not a readable image")
+        raise ConfigError(f"arena.image.file={image.file!r}: not an image OpenCV can read")
     rows, cols = pixels.shape
     width, height = cols * image.resolution, rows * image.resolution
     ox, oy = image.origin if image.origin is not None else (-width / 2, -height / 2)
@@ -536,20 +541,27 @@ def _robot_options(path: str, kind: str, options: dict) -> dict:
             continue
         kind_of = int if isinstance(default, int) else float
         checked[name] = _number(where, value, kind_of)
-        check_value(where, checked[name], {"lo": 0.0, "open_lo": True, "hi": 1e6} if default > 0
-                    else {"lo": -MAX_EXTENT, "hi": MAX_EXTENT})
+        check_value(where, checked[name], {"lo": 0.0, "open_lo": True, "hi": 1000 if kind_of is int else 1e6}
+                    if default > 0 else {"lo": -MAX_EXTENT, "hi": MAX_EXTENT})
+    if "ir_count" in checked:  # (every kind with an IR ring of chosen size has a radius: its enclosing circle)
+        radius = checked.get("radius", defaults["radius"])
+        most = math.floor(2 * math.pi * radius / IR_SENSOR_WIDTH)
+        if checked["ir_count"] > most:
+            raise ConfigError(f"{path}.ir_count={checked['ir_count']}: must be in [1, {most}] (the rim of a "
+                              f"{radius:g} m robot holds one {IR_SENSOR_WIDTH * 100:g} cm IR sensor per "
+                              f"{IR_SENSOR_WIDTH * 100:g} cm)")
     return checked
 
 
 @functools.lru_cache(maxsize=256)
-def _footprint(kind: str, options: tuple) -> tuple[float, float, int | None]:
-    """(enclosing radius, its centre's offset ahead of the pose, IR count or None) of a robot kind."""
+def _footprint(kind: str, options: tuple) -> tuple[float, float]:
+    """(enclosing radius, its centre's offset ahead of the pose) of a robot kind with builder options."""
     try:
         model = build_robot(kind, "probe", **dict(options))
     except (ValueError, ArithmeticError) as exc:
         raise ConfigError(str(exc)) from None
     offset = model.drive.wheelbase / 2 if isinstance(model.drive, TricycleSpec) else 0.0
-    return model.footprint_radius, offset, len(model.ir_sensors)
+    return model.footprint_radius, offset
 
 
 def check(scenario: Scenario, faults: list[Fault]) -> None:
@@ -590,13 +602,7 @@ def check(scenario: Scenario, faults: list[Fault]) -> None:
         if robot.kind not in ROBOT_BUILDERS:
             raise ConfigError(f"{path}.kind={robot.kind!r}: not available; available: {', '.join(ROBOT_BUILDERS)}")
         options = _robot_options(f"{path}.options", robot.kind, robot.options)
-        radius, offset, ir_count = _footprint(robot.kind, tuple(sorted(options.items())))
-        if "ir_count" in options:
-            most = math.floor(2 * math.pi * radius / IR_SENSOR_WIDTH)
-            if ir_count > most:
-                raise ConfigError(f"{path}.options.ir_count={ir_count}: must be in [1, {most}] (a {radius:g} m "
-                                  f"robot's rim holds one {IR_SENSOR_WIDTH * 100:g} cm IR sensor per "
-                                  f"{IR_SENSOR_WIDTH * 100:g} cm)")
+        radius, offset = _footprint(robot.kind, tuple(sorted(options.items())))
         x, y, yaw = robot.pose
         cx, cy = x + offset * math.cos(yaw), y + offset * math.sin(yaw)
         within(f"{path}.pose", cx, cy, radius, f"the centre of a {radius:g} m robot")

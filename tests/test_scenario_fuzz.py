@@ -1,0 +1,152 @@
+"""Fuzzing scenario files: valid files mutated (deleted fields, wrong types, out-of-range numbers, unknown keys,
+broken YAML) either load or get one line ``teamsim: error: ...`` and exit status 2, never a traceback. Runs the CLI
+in-process (``teamsim scenario show MISSION --scenario FILE``), 600 mutations per mission."""
+from __future__ import annotations
+
+import contextlib
+import io
+import math
+import os
+import tempfile
+from collections import Counter
+
+import cv2
+import numpy as np
+import pytest
+import yaml
+from hypothesis import HealthCheck, given, settings, strategies as st
+
+from teamsim.cli import main
+
+WANDER = """\
+mission: wander
+seed: 4
+duration: 30
+arena:
+  size: [8, 8]
+  boxes: [{x: 2, y: 2, half_x: 0.4, half_y: 0.3, yaw: 0.5}]
+  cylinders: [{x: -2, y: 2, radius: 0.3}]
+  bogs: [{x: 0, y: -2.5, half_x: 1, half_y: 0.5}]
+  image: {file: map.png, resolution: 0.5, origin: [-3, -3]}
+objects:
+  pucks: [{x: 1, y: 0}, {x: 1.2, y: 0.3}]
+  boxes: [{x: -1.5, y: -1, yaw: 0.2}]
+robots:
+  red: {kind: diffdrive, pose: [0, 0, 0], options: {radius: 0.3, ir_count: 12}}
+  green: {kind: tracked, pose: [2.5, -2, 1.0], controller: {cruise_speed: 0.2}}
+  blue: {kind: r2, pose: [-2.8, -2.8, 0]}
+radio: {loss: 0.1, range: 5}
+positioning: {period: 0.6}
+timing: {physics_dt: 0.002}
+faults:
+  - {kind: slow, robot: red, time: 2, options: {factor: 0.5}}
+  - {kind: add-robot, robot: blue, time: 5, options: {kind: r2}}
+  - {kind: blind-ir, robot: green, time: 1, options: {sensors: ir1}}
+"""
+NAVIGATE = """\
+mission: navigate
+arena:
+  size: [15, 15]
+  boxes: [{x: 0, y: 0, half_x: 1, half_y: 0.8}, {x: 3, y: -2, half_x: 0.6, half_y: 1.0}]
+robots:
+  red: {kind: tricycle, pose: [-6, 6, -0.78], controller: {method: HRDK}}
+task: {goal: [6, -6], time_limit: 300, map_resolution: 0.1}
+"""
+ODD_VALUES = st.one_of(
+    st.none(), st.booleans(), st.integers(-10**30, 10**30), st.text(max_size=12),
+    st.floats(allow_nan=True, allow_infinity=True),
+    st.sampled_from([-1, 0, 0.0, -0.5, 1e9, 10**400, "1e-3", "nan", [], {}, [1, 2], {"x": 1}, [[1]], "red"]),
+    st.lists(st.floats(-20, 20), max_size=4))
+
+
+def paths(node, prefix=()):
+    """Every (path, value) in a parsed document, the root first."""
+    yield prefix, node
+    items = node.items() if isinstance(node, dict) else enumerate(node) if isinstance(node, list) else ()
+    for key, value in items:
+        yield from paths(value, prefix + (key,))
+
+
+def at(doc, path):
+    for key in path:
+        doc = doc[key]
+    return doc
+
+
+def mutate(text: str, data) -> str:
+    """One mutation of a valid document, as the text of a file."""
+    how = data.draw(st.sampled_from(["delete", "retype", "range", "unknown", "truncate", "garble"]))
+    if how == "truncate":
+        return text[:data.draw(st.integers(0, len(text)))]
+    if how == "garble":
+        k = data.draw(st.integers(0, len(text)))
+        return text[:k] + data.draw(st.sampled_from(["\t", ": ", "[", "}", "- ", "&a ", "*b", "!!python/none ", "'",
+                                                     "\x00", "{{", "\n  x: 1\n", "%", "@"])) + text[k:]
+    doc = yaml.safe_load(text)
+    path, node = data.draw(st.sampled_from(list(paths(doc))))
+    if how == "delete" and path:
+        del at(doc, path[:-1])[path[-1]]
+    elif how == "retype":
+        if path:
+            at(doc, path[:-1])[path[-1]] = data.draw(ODD_VALUES)
+        else:
+            doc = data.draw(ODD_VALUES)
+    elif how == "range":
+        numbers = [(p, v) for p, v in paths(doc) if isinstance(v, (int, float)) and not isinstance(v, bool)]
+        path, value = data.draw(st.sampled_from(numbers))
+        scale = data.draw(st.sampled_from([-1, 0, 1e3, 1e6, -1e-9, math.inf, math.nan]))
+        at(doc, path[:-1])[path[-1]] = value * scale if not isinstance(value, int) or math.isfinite(scale) and \
+            scale == int(scale) and abs(scale) < 1e7 else value + scale
+    elif how == "unknown":
+        target = node if isinstance(node, dict) else doc if isinstance(doc, dict) else None
+        if target is not None:
+            target[data.draw(st.sampled_from(["colour", "sizee", "x", "kind", "1", "robots"]))] = 1
+    return yaml.safe_dump(doc, sort_keys=False)
+
+
+def show(mission: str, file) -> tuple[int, str, str]:
+    """Run the CLI in-process; stderr is caught at the file descriptor, so a library's own message counts too."""
+    out = io.StringIO()
+    with tempfile.TemporaryFile() as caught:
+        saved = os.dup(2)
+        os.dup2(caught.fileno(), 2)
+        try:
+            with contextlib.redirect_stdout(out), contextlib.redirect_stderr(io.TextIOWrapper(os.fdopen(
+                    os.dup(2), "wb"), write_through=True)) as err:
+                code = main(["scenario", "show", mission, "--scenario", str(file)])
+                err.flush()
+                err.close()
+        finally:
+            os.dup2(saved, 2)
+            os.close(saved)
+        caught.seek(0)
+        return code, out.getvalue(), caught.read().decode()
+
+
+@pytest.mark.parametrize("mission, text", [("wander", WANDER), ("navigate", NAVIGATE)])
+def test_mutated_files_load_or_fail_in_one_line(tmp_path, mission, text):
+    image = np.full((8, 8), 255, np.uint8)
+    image[5:7, 0:2] = 0  # a 1 m block: x in [-3, -2], y in [-2.5, -1.5]
+    cv2.imwrite(str(tmp_path / "map.png"), image)
+    file = tmp_path / "fuzzed.yaml"
+    file.write_text(text)
+    assert show(mission, file)[0] == 0, "the unmutated file loads"
+    outcomes = Counter()
+
+    @settings(max_examples=600, deadline=None, derandomize=True, database=None,
+              suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])
+    @given(st.data())
+    def one_mutation(data):
+        file.write_text(mutate(text, data))
+        code, out, err = show(mission, file)
+        assert "Traceback" not in err
+        if code == 0:
+            assert err == "" and yaml.safe_load(out)["mission"] == mission
+        else:
+            assert code == 2, err
+            assert err.startswith("teamsim: error: ") and err.count("\n") == 1, err
+        outcomes[code] += 1
+
+    one_mutation()
+    assert sum(outcomes.values()) >= 600
+    assert outcomes[0] > 30 and outcomes[2] > 100, outcomes
