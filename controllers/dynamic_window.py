@@ -271,19 +271,23 @@ class DynamicWindow:
                             margin: float = 0.0) -> np.ndarray:
         """DC_cd: how far the centre travels along each candidate's arc before the enclosing circle, enlarged by
         ``margin``, touches an obstacle point, capped at DC_cdmax. Points already inside it are left to the
-        safety margin's test (they reject motion towards them); a candidate that does not move the centre never
-        collides."""
+        safety margin's test (they reject motion towards them).
+
+        [RECON] A candidate that does not move the centre (a stop, a point turn) has no path to measure along; it
+        is given the clearance it keeps, the enlarged circle's distance to the nearest point (0 if one is inside
+        it). Given DC_cdmax instead, near obstacles it escapes the alpha_3 scaling of (3.35) that every moving
+        candidate gets there, outscores them all, and a robot at rest stays at rest for good: the deadlock at
+        zero velocity that CC4 (3.31) is there to prevent."""
         p = self.params
         r = self.radius + margin
-        k = v.shape[0]
-        outside = np.hypot(points[:, 0], points[:, 1]) >= r
-        pts = points[outside]
-        dc = np.full(k, p.dc_max)
-        if pts.shape[0] == 0:
-            return dc
-        px, py = pts[:, 0][None, :], pts[:, 1][None, :]
+        distance = np.hypot(points[:, 0], points[:, 1])
+        kept = float(np.clip(distance.min() - r, 0.0, p.dc_max)) if points.shape[0] else p.dc_max
         turning = np.abs(omega) > 1e-9
         moving = (np.abs(v) > 1e-9) | (turning & (abs(self.offset) > 1e-9))
+        pts = points[distance >= r]
+        if pts.shape[0] == 0:
+            return np.where(moving, p.dc_max, kept)
+        px, py = pts[:, 0][None, :], pts[:, 1][None, :]
         # Straight: travel along +-x until a point enters the circle.
         forward = np.sign(v)[:, None]
         ahead = forward * px
@@ -303,7 +307,7 @@ class DynamicWindow:
         arc_hit = np.abs(d - rho) < r
         arc = np.where(arc_hit, rho * np.maximum(ahead_angle - touch, 0.0), np.inf)
         travel = np.where(turning[:, None], arc, straight).min(axis=1)
-        return np.where(moving, np.minimum(travel, p.dc_max), p.dc_max)
+        return np.where(moving, np.minimum(travel, p.dc_max), kept)
 
     def stops_clear(self, v: np.ndarray, omega: np.ndarray, points: np.ndarray, margin: float) -> np.ndarray:
         """ST_v by integration: whether, holding each candidate for one cycle and then braking at a_a along its

@@ -113,9 +113,30 @@ def test_collision_distance_straight_and_on_an_arc_by_hand():
     points = np.array([[1.0, 0.0], [1.0, 1.0]])
     dc = dw.collision_distances(np.array([0.3, 0.3, -0.3, 0.0]), np.array([0.0, 0.3, 0.0, 0.3]), points)
     # Straight on: 1.0 - 0.35. On the unit circle round (0, 1): (1, 1) is a quarter turn away, less the
-    # half-angle at which a 0.35 m circle first touches it. Reversing or turning on the spot: nothing in the way.
-    assert dc == pytest.approx([0.65, math.pi / 2 - math.acos(1 - 0.35 ** 2 / 2), 3.0, 3.0])
+    # half-angle at which a 0.35 m circle first touches it. Reversing: nothing in the way. Turning on the spot
+    # moves nothing: the clearance it keeps, 1.0 - 0.35.
+    assert dc == pytest.approx([0.65, math.pi / 2 - math.acos(1 - 0.35 ** 2 / 2), 3.0, 0.65])
     assert dw.collision_distances(np.array([0.3]), np.array([0.0]), points, margin=0.1)[0] == pytest.approx(0.55)
+
+
+def test_standing_still_gets_the_clearance_it_keeps():
+    dw = differential()
+    still, far = np.zeros(1), np.zeros(1)
+    assert dw.collision_distances(still, far, np.array([[0.0, 0.8]]))[0] == pytest.approx(0.45)
+    assert dw.collision_distances(still, far, np.array([[0.0, 0.8]]), margin=0.1)[0] == pytest.approx(0.35)
+    assert dw.collision_distances(still, far, np.array([[0.0, 0.4]]), margin=0.1)[0] == 0.0  # inside the margin
+    assert dw.collision_distances(still, far, np.zeros((0, 2)))[0] == 3.0  # nothing seen: DC_cdmax
+
+
+def test_at_rest_in_a_narrow_gap_a_differential_robot_moves_on():
+    # Walls 0.09 m and 0.2 m from the rim on either side, target straight ahead: every way forward passes within
+    # DC_cdmin of the walls. Standing still must not outscore moving (it did when a stop counted as DC_cdmax,
+    # and the robot then stood there for good).
+    xs = np.arange(-0.6, 1.6, 0.05)
+    points = np.concatenate([np.column_stack([xs, np.full_like(xs, 0.44)]),
+                             np.column_stack([xs, np.full_like(xs, -0.55)])])
+    decision = differential().decide(DriveState(), points, heading=0.0, d_tgt=10.0)
+    assert decision.branch == "primary" and decision.v > 0
 
 
 def brute_force_collision_distance(v, omega, points, radius, offset):

@@ -42,6 +42,18 @@ def test_boxes_are_arena_boxes_inside_the_world():
         assert abs(box.x) + box.half_x <= half and abs(box.y) + box.half_y <= half
 
 
+@pytest.mark.parametrize("density", [0.05, 0.20])
+def test_obstacles_keep_the_minimum_gap_from_each_other_and_the_walls(density):
+    for seed in range(5):
+        w = world(density, seed)
+        for k, a in enumerate(w.boxes):
+            assert w.size / 2 - max(abs(a.x) + a.half_x, abs(a.y) + a.half_y) >= PARAMS.min_gap - 1e-9
+            for b in w.boxes[k + 1:]:
+                gap = math.hypot(max(abs(a.x - b.x) - a.half_x - b.half_x, 0.0),
+                                 max(abs(a.y - b.y) - a.half_y - b.half_y, 0.0))
+                assert gap >= PARAMS.min_gap - 1e-9
+
+
 def test_start_and_goal_are_clear_corners():
     for seed in range(10):
         w = world(0.20, seed)
