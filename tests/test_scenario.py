@@ -133,3 +133,15 @@ def test_loader_refuses_bad_data_directly():
         load({"objects": {"pucks": [{"x": "left"}]}}, mission_of("wander"))
     assert to_data(load({}, mission_of("navigate")).task) == {"goal": [0.0, 0.0], "time_limit": 450.0,
                                                               "map_resolution": 0.1}
+
+
+def test_docs_list_every_field_as_the_schema_has_it():
+    from pathlib import Path
+
+    from teamsim.scenario_cli import reference
+    from teamsim.tasks import MISSIONS
+
+    page = (Path(__file__).resolve().parents[1] / "docs" / "scenarios.md").read_text()
+    generated = page.split("<!-- fields: generated -->\n")[1].split("<!-- fields: end -->")[0]
+    assert generated == reference(MISSIONS)
+    assert "| `map_resolution` | `0.1` | [0.01, 1] |" in generated
