@@ -69,6 +69,9 @@ class VideoConfig:
     width: int = setting(640, lo=64, hi=3840, meaning="frame width, px")
     height: int = setting(480, lo=48, hi=2160, meaning="frame height, px")
     camera: str = setting("top", meaning="camera: 'top' or ROBOT/track")
+    speedup: float | None = setting(None, lo=1.0, hi=1000.0,
+                                    meaning="simulated seconds per second of video, a time-lapse (unset: the "
+                                            "mission's default, 1 for most)")
 
 
 @dataclass

@@ -123,7 +123,8 @@ def run_trial(config: TrialConfig, seed: int | None = None, progress: bool | Non
     world.record = events
     motivation = MotivationRecorder(events)
     world.record_trace = motivation
-    recorder = TrajectoryRecorder(world.xml, list(world.robots), config.video.fps, world.physics_dt)
+    speedup = config.video.speedup or getattr(mission, "video_speedup", 1.0)
+    recorder = TrajectoryRecorder(world.xml, list(world.robots), config.video.fps, world.physics_dt, speedup)
     if renderer is not None:
         writer = Mp4Writer(run_dir / "video.mp4", config.video.width, config.video.height, config.video.fps)
     bar = Progress(duration, f"{config.mission} seed {config.seed}", enabled=progress)
