@@ -13,21 +13,24 @@ robot then makes (ch.5: "if the robot delivering the 8th puck decides to report,
 report"). The goal zone, drawn on the floor, is the back sixth of the room across the middle half of its width:
 the thesis gives no size. Measures: time; energy by Parker's count (a unit per second while any motor runs) and as
 mechanical work; transports, pucks per transport, reports and reports per move; who ran find-locations.
+
+The mission describes its worlds as scenarios (:mod:`teamsim.scenario`): the room, the spill (``objects.pucks``),
+the team with each robot's cleanup settings, the side-IR faults, and the goal zone and entrance (``task``), so a
+cleanup can be exported, edited (another room, another spill, a fourth robot) and re-run.
 """
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
-from teamsim.config import setting
+from teamsim.config import ConfigError, setting
 from teamsim.controllers.cleanup import FIND, METHODICAL, MOVE, REPORT, WANDER, CleanupParams, CleanupRobot
-from teamsim.faults import Fault
-from teamsim.models.arenas import walled_room
-from teamsim.models.objects import PuckDims, place, puck
+from teamsim.models.objects import PuckDims
 from teamsim.models.robot import RobotModel
-from teamsim.tasks.base import RobotSlot, Scene
+from teamsim.scenario import MAX_EXTENT, Arena, FaultEntry, Objects, RobotEntry, Scenario, Spot, scene_of
+from teamsim.tasks.base import Scene, ScenarioMission
 
 FOOT = 0.3048
 ROOM = (26 * FOOT, 12 * FOOT)  # Parker §2.2.3: the 26 x 12 ft work area
@@ -36,9 +39,10 @@ SIDE_IR_WORKS = ("red",)  # §3.8.1: blue's and green's side IR are dysfunctiona
 SIDE_IR = "ir_left+ir_right"  # the blind-ir fault's sensor prefixes for the side sensors
 # The goal zone (the thesis gives no size): the back sixth of the room's length (as deep as the spill's centre
 # lies from the entrance) across the middle half of its width.
-GOAL_DEPTH, GOAL_WIDTH = ROOM[0] / 6, ROOM[1] / 2
+GOAL_SIZE = (ROOM[0] / 6, ROOM[1] / 2)
 START_X = 0.75  # m from the west wall: clear of a robot following that wall
 START_GAP = 0.6  # m between robots at the start, across the entrance
+ENTRANCE_HALF_WIDTH = 0.4  # m: the entrance marker drawn on the wall (a marker, not a gap: see docs/decisions.md)
 
 
 @dataclass
@@ -51,75 +55,132 @@ class HazardousWasteParams:
                                                             "4 minutes', §3.8)")
     spill_size: float = setting(0.4, lo=0.1, hi=1.5, meaning="side of the square the pucks are scattered in, m")
 
-    @property
-    def target(self) -> int:
-        return math.ceil(self.completion * self.pucks - 1e-9)
+
+@dataclass
+class HazardousWasteTask:
+    """The cleanup's own scenario settings: when it is done, and where the goal zone and entrance are drawn. The
+    robots are told none of this: they find the locations themselves."""
+    completion: float = setting(0.8, lo=0.0, open_lo=True, hi=1.0,
+                                meaning="fraction of the pucks in the goal zone that completes the mission "
+                                        "(ch.5: 80 %)")
+    goal: tuple[float, float] = setting((ROOM[0] / 2 - GOAL_SIZE[0] / 2, 0.0), lo=-MAX_EXTENT, hi=MAX_EXTENT,
+                                        meaning="centre of the goal zone x, y, m (the back centre, §3.8)")
+    goal_size: tuple[float, float] = setting(GOAL_SIZE, lo=0.0, open_lo=True, hi=MAX_EXTENT,
+                                             meaning="the goal zone's extent along x and y, m (not in the thesis: "
+                                                     "the back sixth of the room across half its width)")
+    entrance: tuple[float, float] = setting((-ROOM[0] / 2, 0.0), lo=-MAX_EXTENT, hi=MAX_EXTENT,
+                                            meaning="where the entrance marker is drawn, x, y, m (drawn only: the "
+                                                    "robots take their start as home and report there)")
+
+    def target(self, pucks: int) -> int:
+        """How many pucks in the goal zone complete the mission."""
+        return math.ceil(self.completion * pucks - 1e-9)
+
+    def in_goal(self, x: float, y: float) -> bool:
+        return abs(x - self.goal[0]) <= self.goal_size[0] / 2 and abs(y - self.goal[1]) <= self.goal_size[1] / 2
 
 
-class HazardousWasteMission:
+@dataclass
+class CleanupSettings:
+    """One R-2's cleanup controller (:class:`teamsim.controllers.cleanup.CleanupRobot`)."""
+    methodical: bool = setting(True, meaning="the methodical find (wall-following with the side IR) is in its "
+                                             "repertoire; §3.8.2: only red, whose side IR works")
+    behaviour: CleanupParams = field(default_factory=CleanupParams, metadata={
+        "meaning": "the cleanup behaviours' constants (`CleanupParams` in `teamsim.controllers.cleanup`)"})
+
+
+class HazardousWasteMission(ScenarioMission):
     name = "hazardous-waste"
     summary = "Parker's cleanup: R-2s find a puck spill, carry it to the goal and report, under ALLIANCE"
     Params = HazardousWasteParams
+    Task = HazardousWasteTask
+    Controller = CleanupSettings
     default_duration = 1800.0
     video_speedup = 4.0  # a mission takes minutes: its video plays four simulated seconds a second
 
-    def build(self, params: HazardousWasteParams, rng: np.random.Generator, newcomers, physics_dt: float) -> Scene:
-        length, width = ROOM
-        arena = walled_room(length, width, physics_dt=physics_dt)
-        west = -length / 2
-        arena.worldbody.add("geom", name="entrance", type="box", pos=[west - 0.05, 0, 0.5],
-                            size=[0.055, 0.4, 0.002], rgba=[0.2, 0.6, 0.9, 1], contype=0, conaffinity=0)
-        goal = self.goal_zone()
-        arena.worldbody.add("geom", name="goal_zone", type="box", pos=[goal[0], goal[1], 0.0008],
-                            size=[GOAL_DEPTH / 2, GOAL_WIDTH / 2, 0.0008], rgba=[0.3, 0.75, 0.35, 0.6],
-                            contype=0, conaffinity=0)
-        for k, (x, y) in enumerate(self.spill_layout(params, rng)):
-            place(arena, puck(f"puck{k}"), x, y)
+    def scenario(self, params: HazardousWasteParams, rng: np.random.Generator, newcomers) -> Scenario:
+        west = -ROOM[0] / 2
         team = TEAMS[params.robots]
+        taken = [name for name, _ in newcomers if name in team]
+        if taken:
+            raise ConfigError(f"--fault add-robot:{taken[0]}: robot {taken[0]!r} is already in the team")
+        # The team stands in a row across the entrance; newcomers extend the row, alternately south and north.
         ys = (np.arange(len(team)) - (len(team) - 1) / 2) * START_GAP
-        slots = [RobotSlot(name, "r2", west + START_X, float(y), 0.0) for name, y in zip(team, ys)]
-        slots += [RobotSlot(name, kind, west + START_X, 0.0, 0.0, dormant=True) for name, kind in newcomers]
-        faults = [Fault("blind-ir", name, 0.0, {"sensors": SIDE_IR}) for name in team if name not in SIDE_IR_WORKS]
-        return Scene(arena=arena, robots=slots, params=params, faults=faults,
-                     info={"pucks": [f"puck{k}/puck" for k in range(params.pucks)], "controllers": {}})
+        extra = [(k // 2 + 1) * START_GAP * (-1 if k % 2 == 0 else 1) for k in range(len(newcomers))]
+        rows = [ys[0] + y if y < 0 else ys[-1] + y for y in extra]
+        behaviour = CleanupParams(report_interval=params.report_interval)
+        robots = {name: RobotEntry("r2", (west + START_X, float(y), 0.0),
+                                   controller=CleanupSettings(name in SIDE_IR_WORKS, behaviour))
+                  for name, y in zip(team, ys)}
+        robots.update({name: RobotEntry(kind, (west + START_X, float(y), 0.0),
+                                        controller=CleanupSettings(True, behaviour))
+                       for (name, kind), y in zip(newcomers, rows)})
+        pucks = [Spot(x, y) for x, y in self.spill_layout(params, rng)]
+        blind = [FaultEntry("blind-ir", name, 0.0, {"sensors": SIDE_IR}) for name in team
+                 if name not in SIDE_IR_WORKS]
+        return Scenario(mission=self.name, arena=Arena(size=ROOM), objects=Objects(pucks=pucks), robots=robots,
+                        task=HazardousWasteTask(completion=params.completion), faults=blind)
 
     @staticmethod
-    def spill_centre() -> tuple[float, float]:
-        return -ROOM[0] / 2 + ROOM[0] / 6, 0.0
-
-    @staticmethod
-    def goal_zone() -> tuple[float, float]:
-        return ROOM[0] / 2 - GOAL_DEPTH / 2, 0.0
-
-    def spill_layout(self, params: HazardousWasteParams, rng: np.random.Generator) -> list[tuple[float, float]]:
-        """Puck centres scattered uniformly in the spill square, at least a puck's diameter plus 1 cm apart."""
-        cx, cy = self.spill_centre()
+    def spill_layout(params: HazardousWasteParams, rng: np.random.Generator) -> list[tuple[float, float]]:
+        """Puck centres scattered uniformly in the spill square at the centre of the front third, at least a
+        puck's diameter plus 1 cm apart."""
+        centre = np.array([-ROOM[0] / 2 + ROOM[0] / 6, 0.0])
         gap = 2 * PuckDims().radius + 0.01
         points: list[np.ndarray] = []
         while len(points) < params.pucks:
-            p = np.array([cx, cy]) + rng.uniform(-0.5, 0.5, size=2) * params.spill_size
+            p = centre + rng.uniform(-0.5, 0.5, size=2) * params.spill_size
             if all(np.hypot(*(p - q)) >= gap for q in points):
                 points.append(p)
         return [(float(x), float(y)) for x, y in points]
 
+    def check_scenario(self, scenario: Scenario) -> None:
+        """R-2s only (the cleanup needs a gripper), pucks to move, and a goal zone inside the room."""
+        for name, robot in scenario.robots.items():
+            if robot.kind != "r2":
+                raise ConfigError(f"robots.{name}.kind={robot.kind!r}: the cleanup is done by R-2s; allowed: r2")
+        if not scenario.objects.pucks:
+            raise ConfigError("objects.pucks: the cleanup needs at least one puck")
+        task, (hx, hy) = scenario.task, (scenario.arena.size[0] / 2, scenario.arena.size[1] / 2)
+        for axis, (centre, size, half) in enumerate(zip(task.goal, task.goal_size, (hx, hy))):
+            if abs(centre) + size / 2 > half + 1e-9:
+                raise ConfigError(f"task.goal / task.goal_size: the goal zone must lie inside the arena, "
+                                  f"{'xy'[axis]} in [{-half:g}, {half:g}]; it spans [{centre - size / 2:g}, "
+                                  f"{centre + size / 2:g}]")
+
+    def scene(self, scenario: Scenario, newcomers, physics_dt: float) -> Scene:
+        scene = scene_of(scenario, newcomers, physics_dt)
+        task, worldbody = scenario.task, scene.arena.worldbody
+        # The entrance marker stands just outside the wall nearest it, on its outer face.
+        hx, hy = scenario.arena.size[0] / 2, scenario.arena.size[1] / 2
+        x, y = task.entrance
+        thickness = scenario.arena.wall_thickness
+        along_y = hx - abs(x) <= hy - abs(y)  # on the west or east wall
+        pos = ([math.copysign(hx + thickness / 2, x), y] if along_y else [x, math.copysign(hy + thickness / 2, y)])
+        size = [thickness / 2 + 0.005, ENTRANCE_HALF_WIDTH] if along_y else [ENTRANCE_HALF_WIDTH, thickness / 2 + 0.005]
+        worldbody.add("geom", name="entrance", type="box", pos=[*pos, scenario.arena.wall_height],
+                      size=[*size, 0.002], rgba=[0.2, 0.6, 0.9, 1], contype=0, conaffinity=0)
+        worldbody.add("geom", name="goal_zone", type="box", pos=[*task.goal, 0.0008],
+                      size=[task.goal_size[0] / 2, task.goal_size[1] / 2, 0.0008], rgba=[0.3, 0.75, 0.35, 0.6],
+                      contype=0, conaffinity=0)
+        scene.info.update(pucks=[f"puck{k}/puck" for k in range(len(scenario.objects.pucks))], controllers={},
+                          target=task.target(len(scenario.objects.pucks)))
+        return scene
+
     def controller(self, robot: RobotModel, scene: Scene, rng: np.random.Generator):
-        params = CleanupParams(report_interval=scene.params.report_interval)
-        brain = CleanupRobot(robot, rng, params, methodical=robot.name in SIDE_IR_WORKS)
+        settings = scene.scenario.robots[robot.name].controller
+        brain = CleanupRobot(robot, rng, settings.behaviour, methodical=settings.methodical)
         scene.info["controllers"][robot.name] = brain
         return brain
 
     # -- measures -------------------------------------------------------------------------------------------
     @staticmethod
     def pucks_at_goal(world) -> int:
-        gx, gy = HazardousWasteMission.goal_zone()
-        count = 0
-        for body in world.scene.info["pucks"]:
-            x, y = world.data.body(body).xpos[:2]
-            count += abs(x - gx) <= GOAL_DEPTH / 2 and abs(y - gy) <= GOAL_WIDTH / 2
-        return count
+        task = world.scene.scenario.task
+        return sum(task.in_goal(*world.data.body(body).xpos[:2]) for body in world.scene.info["pucks"])
 
     def done(self, world) -> bool:
-        if self.pucks_at_goal(world) < world.scene.params.target:
+        if self.pucks_at_goal(world) < world.scene.info["target"]:
             return False
         brains = world.scene.info["controllers"]
         return not any(r.active and (brains[n].active == REPORT or brains[n].knowledge.report_due(world.time))
@@ -128,13 +189,14 @@ class HazardousWasteMission:
     def outcome(self, world) -> tuple[bool, dict]:
         brains = world.scene.info["controllers"]
         at_goal = self.pucks_at_goal(world)
+        target = world.scene.info["target"]
         transports = sum(b.knowledge.transports for b in brains.values())
         reports = sum(b.knowledge.reports for b in brains.values())
         robots = world.robot_summary()
         find_sets = (METHODICAL, WANDER)
         metrics = {
             "pucks_at_goal": at_goal,
-            "target": world.scene.params.target,
+            "target": target,
             "mission_time_s": round(world.time, 3),
             "energy_parker_units": round(sum(r["parker_energy_units"] for r in robots.values()), 3),
             "energy_j": round(sum(r["energy_j"] for r in robots.values()), 3),
@@ -150,4 +212,4 @@ class HazardousWasteMission:
                                             for s in sets), 3)
                             for task, sets in ((FIND, find_sets), (MOVE, (MOVE,)), (REPORT, (REPORT,)))},
         }
-        return at_goal >= world.scene.params.target, metrics
+        return at_goal >= target, metrics

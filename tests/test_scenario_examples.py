@@ -25,8 +25,9 @@ def test_one_per_mission_and_one_per_density():
 
 @pytest.mark.parametrize("file", FILES, ids=[f.stem for f in FILES])
 def test_example_runs(capsys, tmp_path, file):
-    code = main(["run", file.stem.split("-")[0], "--scenario", str(file), "--duration", "0.5", "--out", str(tmp_path)])
-    assert code in (0, 1), capsys.readouterr().err  # (1: navigate has not arrived in half a second)
+    mission = read(file)["mission"]
+    code = main(["run", mission, "--scenario", str(file), "--duration", "0.5", "--out", str(tmp_path)])
+    assert code in (0, 1), capsys.readouterr().err  # (1: navigate has not arrived, nor the cleanup finished)
 
 
 @pytest.mark.parametrize("density", DENSITIES)

@@ -52,6 +52,18 @@ robots:
   red: {kind: tricycle, pose: [-6, 6, -0.78], controller: {method: HRDK}}
 task: {goal: [6, -6], time_limit: 300, map_resolution: 0.1}
 """
+HAZARDOUS_WASTE = """\
+mission: hazardous-waste
+arena: {size: [7.9, 3.6]}
+objects:
+  pucks: [{x: -2.6, y: 0}, {x: -2.5, y: 0.1}, {x: -2.7, y: -0.1}]
+robots:
+  red: {kind: r2, pose: [-3.2, -0.6, 0], controller: {methodical: true, behaviour: {report_interval: 120}}}
+  green: {kind: r2, pose: [-3.2, 0.6, 0], controller: {methodical: false, behaviour: {drive: {cruise: 0.25}}}}
+task: {completion: 0.6, goal: [3.3, 0], goal_size: [1.3, 1.8], entrance: [-3.95, 0]}
+faults:
+  - {kind: blind-ir, robot: green, time: 0, options: {sensors: ir_left+ir_right}}
+"""
 ODD_VALUES = st.one_of(
     st.none(), st.booleans(), st.integers(-10**30, 10**30), st.text(max_size=12),
     st.floats(allow_nan=True, allow_infinity=True),
@@ -123,7 +135,8 @@ def show(mission: str, file) -> tuple[int, str, str]:
         return code, out.getvalue(), caught.read().decode()
 
 
-@pytest.mark.parametrize("mission, text", [("wander", WANDER), ("navigate", NAVIGATE)])
+@pytest.mark.parametrize("mission, text", [("wander", WANDER), ("navigate", NAVIGATE),
+                                           ("hazardous-waste", HAZARDOUS_WASTE)])
 def test_mutated_files_load_or_fail_in_one_line(tmp_path, mission, text):
     image = np.full((8, 8), 255, np.uint8)
     image[5:7, 0:2] = 0  # a 1 m block: x in [-3, -2], y in [-2.5, -1.5]
