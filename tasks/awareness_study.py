@@ -14,8 +14,6 @@ replicated, move-spill is not).
 """
 from __future__ import annotations
 
-import csv
-import io
 import math
 from dataclasses import dataclass
 from pathlib import Path
@@ -25,7 +23,7 @@ import numpy as np
 from teamsim.config import TrialConfig
 from teamsim.faults import Fault
 from teamsim.plots import grouped_bars
-from teamsim.recording import write_atomic
+from teamsim.recording import write_atomic, write_csv
 from teamsim.sweep import run_trials
 from teamsim.tasks.hazardous_waste import TEAMS, HazardousWasteParams
 
@@ -78,11 +76,7 @@ def run_study(study: AwarenessStudy) -> Path:
     summaries = run_trials(configs, workers=study.workers)
     rows = [result_row(c, s) for c, s in zip(configs, summaries)]
     study.out.mkdir(parents=True, exist_ok=True)
-    buffer = io.StringIO()
-    writer = csv.DictWriter(buffer, fieldnames=COLUMNS)
-    writer.writeheader()
-    writer.writerows(rows)
-    write_atomic(study.out / "results.csv", buffer.getvalue().encode())
+    write_csv(study.out / "results.csv", COLUMNS, rows)
     write_report(study, rows)
     return study.out
 

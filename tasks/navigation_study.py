@@ -9,9 +9,7 @@ both finished), with paired two-sided t-test p-values.
 """
 from __future__ import annotations
 
-import csv
 import dataclasses
-import io
 import math
 import zlib
 from dataclasses import dataclass, field
@@ -21,7 +19,7 @@ import numpy as np
 
 from teamsim.config import TrialConfig
 from teamsim.plots import grouped_bars
-from teamsim.recording import write_atomic
+from teamsim.recording import write_atomic, write_csv
 from teamsim.stats import paired_t_test
 from teamsim.sweep import run_trials
 from teamsim.tasks.navigate import METHODS, TABLE_3_1, NavigateParams, time_limit
@@ -134,11 +132,7 @@ def run_study(study: NavigationStudy) -> Path:
 
 
 def write_results(path: Path, rows: list[dict]) -> None:
-    buffer = io.StringIO()
-    writer = csv.DictWriter(buffer, fieldnames=COLUMNS)
-    writer.writeheader()
-    writer.writerows(rows)
-    write_atomic(path, buffer.getvalue().encode())
+    write_csv(path, COLUMNS, rows)
 
 
 @dataclass(frozen=True)

@@ -12,6 +12,9 @@ from teamsim.config import ConfigError, TrialConfig, apply_setting, validate
 from teamsim.faults import FAULT_KINDS, SPEC_FORM, parse_fault
 from teamsim.gl import RenderBackendError
 
+# teamsim.tasks.cleanup_fault_study.CONDITIONS, spelled out so that building the parser imports no physics
+CLEANUP_CONDITIONS = ("none", "kill-red", "radio-off", "break-gripper")
+
 EXIT_USAGE = 2
 
 
@@ -91,6 +94,15 @@ def _build_parser() -> argparse.ArgumentParser:
     awareness.add_argument("--seed", type=int, default=0)
     awareness.add_argument("--out", type=Path, default=Path("renders/study-awareness"))
 
+    faults = studies.add_parser("cleanup-faults", help="Parker §3.8.4: the 3-robot cleanup with red killed during "
+                                                       "the search, the radio off, a gripper broken")
+    faults.add_argument("--missions", type=_positive_int("--missions"), default=10, help="missions per condition")
+    faults.add_argument("--conditions", type=_csv_of("condition", CLEANUP_CONDITIONS), default=CLEANUP_CONDITIONS,
+                        help=f"comma-separated: {','.join(CLEANUP_CONDITIONS)}")
+    faults.add_argument("--workers", type=_positive_int("--workers"), default=2)
+    faults.add_argument("--seed", type=int, default=0)
+    faults.add_argument("--out", type=Path, default=Path("renders/study-cleanup-faults"))
+
     bench = commands.add_parser("bench", help="benchmarks")
     bench.add_argument("what", choices=("physics", "render", "nav", "alliance", "allocate"))
     bench.add_argument("--seconds", type=float, default=None, help="simulated seconds per measurement")
@@ -164,6 +176,12 @@ def cmd_study(args) -> int:
             raise ConfigError("--duration: must be > 0 simulated seconds")
         out = run_study(AwarenessStudy(missions=args.missions, seed=args.seed, workers=args.workers, out=args.out,
                                        duration=args.duration))
+        print(f"wrote {out / 'report.md'} and {out / 'results.csv'}")
+    elif args.study == "cleanup-faults":
+        from teamsim.tasks.cleanup_fault_study import CleanupFaultStudy, run_study
+
+        out = run_study(CleanupFaultStudy(missions=args.missions, seed=args.seed, conditions=args.conditions,
+                                          workers=args.workers, out=args.out))
         print(f"wrote {out / 'report.md'} and {out / 'results.csv'}")
     elif args.study == "lalliance":
         from teamsim.tasks.lalliance_study import run_study
@@ -242,6 +260,8 @@ def cmd_list(_args) -> int:
     print("  navigation       Chand ch.3: FRC, HRDK, HRDU, ODW, ODWDS, RFRC x robots A, B, C x densities")
     print("  two-tier-astar   Chand ch.4: memory-constrained two-tiered A* vs monolithic, no physics")
     print("  lalliance        Parker §4.5: L-ALLIANCE strategies I-IV, abstract (no physics)")
+    print("  awareness        Parker ch.5: the cleanup with and without awareness, versions I-IV")
+    print("  cleanup-faults   Parker §3.8.4: the cleanup with red killed, the radio off, a gripper broken")
     return 0
 
 
