@@ -35,9 +35,11 @@ import numpy as np
 
 from teamsim.config import setting
 from teamsim.controllers import gripper as G
-from teamsim.controllers.alliance import AllianceController, AllianceParams, BehaviourSetDefinition, MotivationRates
+from teamsim.controllers.alliance import (AllianceController, AllianceParams, AllianceRobot, BehaviourSetDefinition,
+                                          MotivationRates)
 from teamsim.controllers.base import Command, Observation
 from teamsim.controllers.goto import AvoidObstacles, DriveParams, steer_to, turn_to
+from teamsim.controllers.learned_acquiescence import LearnedAcquiescence, LearningParams
 from teamsim.controllers.pose_estimate import PoseEstimate
 from teamsim.models.r2 import TIP_IR
 from teamsim.models.robot import RobotModel
@@ -77,6 +79,8 @@ class CleanupParams:
     # An approach ends within 12 s: 0.3 m of IR range at 6 cm/s plus the blind 4 s; longer means the fingertips
     # saw a robot (Parker's R-2s also took each other's fingers for pucks, §3.8.4).
     gripper: G.GripperParams = field(default_factory=lambda: G.GripperParams(approach_timeout=12.0))
+    # move-spill learns from its own loads (L-ALLIANCE's failure penalty): a robot whose gripper breaks gives it up
+    learning: LearningParams = field(default_factory=LearningParams)
 
 
 def locations_from_extents(extents: np.ndarray, home: np.ndarray, clearance: float) -> dict:
@@ -431,7 +435,8 @@ class ReportProgress(SetController):
 RATES = {
     METHODICAL: MotivationRates(delta_fast=1 / 2, delta_slow=1 / 300, phi=300.0, psi=300.0, lam=600.0),
     WANDER: MotivationRates(delta_fast=1 / 8, delta_slow=1 / 300, phi=300.0, psi=300.0, lam=600.0),
-    MOVE: MotivationRates(delta_fast=1 / 3, delta_slow=1 / 30, phi=0.5, psi=math.inf, lam=600.0),
+    MOVE: MotivationRates(delta_fast=1 / 3, delta_slow=1 / 30, phi=0.5, psi=math.inf, lam=600.0),  # lam: learned
+    # (CleanupParams.learning: 3 x its expected time per load, 600 s before the first; this 600 s with learning off)
     REPORT: MotivationRates(delta_fast=1.0, delta_slow=1 / 90, phi=90.0, psi=60.0, lam=180.0),
 }
 
@@ -458,7 +463,9 @@ class CleanupRobot:
         self.sets = {name: controller for name, _, controller, _ in sets}
         definitions = [BehaviourSetDefinition(name, applicable, controller, task=task, rates=RATES[name])
                        for name, task, controller, applicable in sets]
-        self.alliance = AllianceController(robot.name, definitions, alliance)
+        core = AllianceRobot(robot.name, [d.behaviour_set for d in definitions], alliance)
+        self.learning = LearnedAcquiescence(core, (MOVE,), params.learning)
+        self.alliance = AllianceController(robot.name, definitions, alliance, selector=self.learning)
         self.active = "idle"
 
     def __call__(self, obs: Observation) -> Command:

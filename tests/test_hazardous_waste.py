@@ -66,6 +66,39 @@ def test_without_radio_every_robot_finds_and_reports_for_itself(tmp_path):
     assert all(r["located"] for r in metrics["per_robot"].values())
 
 
+def test_a_robot_with_a_broken_gripper_gives_up_move_spill(tmp_path, capsys):
+    """L-ALLIANCE's failure penalty (§4.6): green's gripper breaks at 100 s; it gives move-spill up at lambda
+    (2 x its 40 s prior, set short so that it shows within one mission), is charged twice the time it tried, and
+    waits that long before trying again. The others finish the cleanup."""
+    import json
+
+    from teamsim.cli import main
+
+    learning = "robots.green.controller.behaviour.learning"
+    code = main(["run", "hazardous-waste", "--seed", "9", "--out", str(tmp_path), "--run-id", "run",
+                 "--set", f"{learning}.prior_task_time=40", "--set", f"{learning}.lambda_factor=2",
+                 "--fault", "break-gripper:green@100"])
+    assert code == 0, capsys.readouterr().err
+    run_dir = tmp_path / "hazardous-waste" / "run"
+    summary = json.loads((run_dir / "summary.json").read_text())
+    assert summary["metrics"]["per_robot"]["green"]["transports"] == 0
+    events = [json.loads(line) for line in (run_dir / "events.jsonl").read_text().splitlines()]
+    green = [e for e in events if e.get("robot") == "green" and e["event"] == "motivation"
+             and e["behaviour_set"] == "move-spill"]
+    gave_up = [e["t"] for e in green if e["kind"] == "acquiescence" and e["detail"] == "lambda"]
+    started = [e["t"] for e in green if e["kind"] == "activate"]
+    assert gave_up, "green never gave move-spill up"
+    first_start = max(t for t in started if t < gave_up[0])
+    assert gave_up[0] - first_start == pytest.approx(80.0, abs=0.5)  # lambda = 2 x 40 s
+    again = [t for t in started if t > gave_up[0]]
+    # It waits its expected time (the failure, charged 2 x 80 s; less one tick at the old rate) before trying
+    # again, and then gives up after twice that: attempts grow rarer as the penalty grows the expected time.
+    assert again and again[0] - gave_up[0] > 150.0
+    later = [t for t in gave_up if t > again[0]]
+    assert not later or later[0] - again[0] == pytest.approx(320.0, abs=1.0)
+    assert summary["status"] == "completed"
+
+
 @pytest.mark.parametrize("spec", ["blind-ir:red@0,sensors=ir_nose", "blind-ir:red@0,sensors=ir_left+bogus"])
 def test_a_blind_ir_fault_must_name_sensors_the_robot_has(tmp_path, spec):
     from teamsim.config import ConfigError
