@@ -358,6 +358,26 @@ def test_takeover_after_a_death_within_phi_tau_and_one_period():
     assert team.done()
 
 
+def test_a_silent_claim_lapses_after_tau():
+    """The takeover's tau part: with patience phi far longer than the trial, the teammate can only take the task
+    over because the dead robot's claim lapses tau after its last message; then it grows at delta_fast."""
+    radio = RadioConfig(rate_hz=1.0)
+    patient = MotivationRates(delta_fast=0.25, delta_slow=1 / 2000, phi=1000.0, psi=100.0, lam=500.0)
+    slower = replace(patient, delta_fast=0.1)  # b would start after 10 s: it hears a's claim first
+
+    def make(name, sets):
+        return AllianceRobot(name, [replace(s, rates=patient if name == "a" else slower) for s in sets],
+                             AllianceParams(tau=radio.timeout))
+
+    team = AbstractTeam([Task("x")], {"a": {"x": 200.0}, "b": {"x": 200.0}}, make, radio, dt=0.1)
+    death = 30.0
+    team.run(60.0, events={death: lambda: team.kill("a")})
+    assert team.first_time("a", "x") < team.first_time("b", "x")
+    takeover = team.first_time("b", "x")
+    # the last message came at most one broadcast period (1 s) before the death
+    assert death + radio.timeout - 1.0 < takeover <= death + radio.timeout + 1 / slower.delta_fast + 2 * team.dt
+
+
 def test_division_of_labour_returns_when_a_robot_is_revived():
     """Claims 1-2 (§6.1.2, box pushing): each end is needed again once the other end has been pushed. With its
     teammate dead the survivor pushes both ends; revived, the teammate takes its end back."""
