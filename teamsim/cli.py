@@ -5,6 +5,7 @@ Every bad input ends in one line, ``teamsim: error: ...``, and exit status 2.
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 from pathlib import Path
 
@@ -324,6 +325,9 @@ def main(argv: list[str] | None = None) -> int:
     except (UsageError, ConfigError, RenderBackendError) as exc:
         print(f"teamsim: error: {exc}", file=sys.stderr)
         return EXIT_USAGE
+    except BrokenPipeError:  # the output went to a program that stopped reading (teamsim list | head)
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())  # no second error at interpreter exit
+        return 1
 
 
 if __name__ == "__main__":

@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import json
+import os
 import subprocess
 import sys
 
@@ -60,6 +61,17 @@ def test_console_script_errors_without_traceback(tmp_path):
     assert proc.stderr == "teamsim: error: --set robots=abc: expected an integer\n"
 
 
+def test_output_into_a_closed_pipe_is_no_traceback(tmp_path):
+    """`teamsim list | head -1`: the reader has gone; teamsim stops quietly (its stdout is a pipe whose read end
+    is closed, and unbuffered, so the first print meets the broken pipe)."""
+    script = ("import os, sys; r, w = os.pipe(); os.close(r); os.dup2(w, 1); "
+              "from teamsim.cli import main; sys.exit(main(['list']))")
+    proc = subprocess.run([sys.executable, "-c", script], capture_output=True, cwd=tmp_path,
+                          env={**os.environ, "PYTHONUNBUFFERED": "1"})
+    assert proc.returncode == 1
+    assert proc.stderr == b""
+
+
 def test_run_writes_summary_and_is_quiet_off_a_terminal(capsys, tmp_path):
     code, out, err = run_cli(capsys, "run", "wander", "--duration", "3", "--seed", "5", "--out", str(tmp_path),
                              "--run-id", "r", "--set", "robots=2", "--set", "radio.latency=0.5",
@@ -75,8 +87,11 @@ def test_run_writes_summary_and_is_quiet_off_a_terminal(capsys, tmp_path):
 def test_list_names_robots_and_missions(capsys):
     code, out, _ = run_cli(capsys, "list")
     assert code == 0
-    for word in ("diffdrive", "10 IR", "r2", "genghis2", "tricycle", "tracked", "wander"):
+    for word in ("diffdrive", "10 IR", "r2", "genghis2", "tricycle", "tracked", "wander", "hazardous-waste"):
         assert word in out
+    # each robot with its sensors and actuators
+    assert "8 IR (0.3 m)" in out and "2 break-beams" in out and "grip: grip; lift: lift" in out
+    assert "inclinometer" in out and "swing_lf, lift_lf" in out and "11 IR (1.5 m)" in out and "steer, drive" in out
 
 
 @pytest.mark.parametrize("kind", sorted(ROBOT_BUILDERS))

@@ -125,7 +125,9 @@ def test_tricycle_cannot_turn_in_place():
 
 
 def test_tricycle_reverses_out_of_a_dead_end():
-    """A corridor 1.4 m wide, closed ahead: the tricycle (1 m across) cannot turn round in it, so it backs out."""
+    """A corridor 1.7 m wide between its walls, closed ahead. The tricycle's tightest U-turn sweeps a circle about
+    1.76 m across (rear axle on a wheelbase / tan 60 deg = 0.29 m radius, the 0.5 m pentagon centred 0.25 m ahead
+    of it), so it cannot turn round in it: it sees the end wall and backs out straight."""
     walls = (Box(0.0, 0.95, 2.0, 0.1), Box(0.0, -0.95, 2.0, 0.1), Box(2.1, 0.0, 0.1, 1.05))
     commands = {"v": 0.2}
     world, red = solo("tricycle", lambda o: (commands["v"], 0.0), x=-1.0, obstacles=walls)
