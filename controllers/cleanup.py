@@ -39,6 +39,7 @@ from teamsim.controllers.alliance import (AllianceController, AllianceParams, Al
                                           MotivationRates)
 from teamsim.controllers.base import Command, Observation
 from teamsim.controllers.goto import AvoidObstacles, DriveParams, steer_to, turn_to
+from teamsim.controllers.lalliance import TaskStatistics
 from teamsim.controllers.learned_acquiescence import LearnedAcquiescence, LearningParams
 from teamsim.controllers.pose_estimate import PoseEstimate
 from teamsim.models.r2 import TIP_IR
@@ -448,7 +449,8 @@ class CleanupRobot:
     (GRC_RED = A; GRC_BLUE = GRC_GREEN lack it, §3.8.2). The set order is the priority order of ties."""
 
     def __init__(self, robot: RobotModel, rng: np.random.Generator, params: CleanupParams = CleanupParams(),
-                 methodical: bool = True, alliance: AllianceParams = AllianceParams()):
+                 methodical: bool = True, alliance: AllianceParams = AllianceParams(),
+                 learned: TaskStatistics | None = None):
         self.knowledge = CleanupKnowledge(params.report_interval)
         self.estimate = PoseEstimate(robot.drive)
         bumpers = tuple(name for name in robot.touch if name.startswith("bump_"))
@@ -464,7 +466,7 @@ class CleanupRobot:
         definitions = [BehaviourSetDefinition(name, applicable, controller, task=task, rates=RATES[name])
                        for name, task, controller, applicable in sets]
         core = AllianceRobot(robot.name, [d.behaviour_set for d in definitions], alliance)
-        self.learning = LearnedAcquiescence(core, (MOVE,), params.learning)
+        self.learning = LearnedAcquiescence(core, (MOVE,), params.learning, learned)
         self.alliance = AllianceController(robot.name, definitions, alliance, selector=self.learning)
         self.active = "idle"
 

@@ -67,12 +67,14 @@ class _Learned:
 class LearnedAcquiescence:
     """ALLIANCE over ``core``'s sets, with L-ALLIANCE's learned lambda and failure penalty on ``learned`` sets."""
 
-    def __init__(self, core: AllianceRobot, learned: Iterable[str], params: LearningParams = LearningParams()):
+    def __init__(self, core: AllianceRobot, learned: Iterable[str], params: LearningParams = LearningParams(),
+                 statistics: TaskStatistics | None = None):
+        """``statistics``: what the robot learned in earlier missions (else it starts from the prior)."""
         self.core = core
         self.params = params
         self.sets = core.sets
         self.learned = tuple(learned)
-        self.statistics = TaskStatistics(core.name, params.trials_kept)
+        self.statistics = statistics or TaskStatistics(core.name, params.trials_kept)
         self.failed_last = dict.fromkeys(self.learned, False)
 
     def expected_time(self, name: str) -> float:

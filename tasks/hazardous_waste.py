@@ -22,11 +22,13 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from pathlib import Path
 
 import numpy as np
 
 from teamsim.config import ConfigError, setting
 from teamsim.controllers.cleanup import FIND, METHODICAL, MOVE, REPORT, WANDER, CleanupParams, CleanupRobot
+from teamsim.controllers.lalliance import TaskStatistics, load_statistics, save_statistics
 from teamsim.models.objects import PuckDims
 from teamsim.models.robot import RobotModel
 from teamsim.scenario import MAX_EXTENT, Arena, FaultEntry, Objects, RobotEntry, Scenario, Spot, scene_of
@@ -87,6 +89,21 @@ class CleanupSettings:
                                              "repertoire; §3.8.2: only red, whose side IR works")
     behaviour: CleanupParams = field(default_factory=CleanupParams, metadata={
         "meaning": "the cleanup behaviours' constants (`CleanupParams` in `teamsim.controllers.cleanup`)"})
+    learned: str = setting("", meaning="what it learned before: a run's `learned/ROBOT.json` (L-ALLIANCE's task "
+                                       "times carry over from mission to mission, §4.4.2); empty: nothing")
+
+
+def read_statistics(field_name: str, path: str, robot: str) -> TaskStatistics:
+    """A robot's learned statistics from a file, or a one-line error naming the field."""
+    try:
+        statistics = load_statistics(path)
+    except OSError as exc:
+        raise ConfigError(f"{field_name}={path!r}: cannot read ({exc.strerror or exc})") from None
+    except ValueError as exc:  # (json's decode errors are ValueErrors too)
+        raise ConfigError(f"{field_name}={path!r}: {' '.join(str(exc).split())}") from None
+    if statistics.robot != robot:
+        raise ConfigError(f"{field_name}={path!r}: these are {statistics.robot}'s statistics, not {robot}'s")
+    return statistics
 
 
 class HazardousWasteMission(ScenarioMission):
@@ -169,9 +186,18 @@ class HazardousWasteMission(ScenarioMission):
 
     def controller(self, robot: RobotModel, scene: Scene, rng: np.random.Generator):
         settings = scene.scenario.robots[robot.name].controller
-        brain = CleanupRobot(robot, rng, settings.behaviour, methodical=settings.methodical)
+        learned = None
+        if settings.learned:
+            learned = read_statistics(f"robots.{robot.name}.controller.learned", settings.learned, robot.name)
+        brain = CleanupRobot(robot, rng, settings.behaviour, methodical=settings.methodical, learned=learned)
         scene.info["controllers"][robot.name] = brain
         return brain
+
+    def write_outputs(self, world, run_dir: Path) -> None:
+        """Each robot's learned task times, ``learned/ROBOT.json``: readable, and the next mission's start."""
+        (run_dir / "learned").mkdir(exist_ok=True)
+        for name, brain in world.scene.info["controllers"].items():
+            save_statistics(run_dir / "learned" / f"{name}.json", brain.learning.statistics)
 
     # -- measures -------------------------------------------------------------------------------------------
     @staticmethod

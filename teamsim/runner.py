@@ -144,6 +144,8 @@ def run_trial(config: TrialConfig, seed: int | None = None, progress: bool | Non
         simulate(world, mission, duration, recorder, capture, bar.update)
         completed, metrics = mission.outcome(world)
         status = "completed" if completed else "failed"
+        if hasattr(mission, "write_outputs"):  # what a mission keeps beyond the summary (learned statistics, ...)
+            mission.write_outputs(world, run_dir)
     except PhysicsUnstable as exc:
         status, error = "unstable", str(exc)
     except KeyboardInterrupt:

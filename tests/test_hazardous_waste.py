@@ -105,3 +105,29 @@ def test_a_blind_ir_fault_must_name_sensors_the_robot_has(tmp_path, spec):
 
     with pytest.raises(ConfigError, match="sensors: no IR sensor of red starts with"):
         cleanup(tmp_path, 0, spec)
+
+
+def test_learned_task_times_carry_over_through_a_readable_file(tmp_path, capsys):
+    """L-ALLIANCE's statistics persist from mission to mission (§4.4.2): every run writes learned/ROBOT.json, and a
+    robot's `learned` setting starts the next mission from such a file."""
+    import json
+
+    from teamsim.cli import main
+    from teamsim.controllers.lalliance import TaskStatistics, save_statistics
+
+    before = TaskStatistics("green")
+    for seconds in (140.0, 160.0, 900.0):  # two loads and one failure (charged twice the 450 s tried)
+        before.record_own("move-spill", seconds)
+    file = tmp_path / "green.json"
+    save_statistics(file, before)
+    code = main(["run", "hazardous-waste", "--seed", "1", "--duration", "3", "--out", str(tmp_path),
+                 "--run-id", "run", "--set", f"robots.green.controller.learned={file}"])
+    assert code == 1, capsys.readouterr().err  # (3 s: not completed)
+    learned = tmp_path / "hazardous-waste" / "run" / "learned"
+    assert json.loads((learned / "green.json").read_text())["own"] == {"move-spill": [140.0, 160.0, 900.0]}
+    assert json.loads((learned / "red.json").read_text())["own"] == {}
+
+    code = main(["run", "hazardous-waste", "--duration", "1", "--out", str(tmp_path),
+                 "--set", f"robots.red.controller.learned={file}"])
+    assert code == 2
+    assert "robots.red.controller.learned=" in capsys.readouterr().err
