@@ -437,7 +437,7 @@ RATES = {
     METHODICAL: MotivationRates(delta_fast=1 / 2, delta_slow=1 / 300, phi=300.0, psi=300.0, lam=600.0),
     WANDER: MotivationRates(delta_fast=1 / 8, delta_slow=1 / 300, phi=300.0, psi=300.0, lam=600.0),
     MOVE: MotivationRates(delta_fast=1 / 3, delta_slow=1 / 30, phi=0.5, psi=math.inf, lam=600.0),  # lam: learned
-    # (CleanupParams.learning: 3 x its expected time per load, 600 s before the first; this 600 s with learning off)
+    # (CleanupParams.learning: 3 x its expected time per load, at least 600 s; this 600 s with learning off)
     REPORT: MotivationRates(delta_fast=1.0, delta_slow=1 / 90, phi=90.0, psi=60.0, lam=180.0),
 }
 

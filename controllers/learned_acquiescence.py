@@ -13,7 +13,9 @@ exactly that for the sets it is given and keeps ALLIANCE's fixed rates everywher
 
 - task_time = mean + 1 s.d. of the last ``trials_kept`` own trials (:class:`TaskStatistics`), or
   ``prior_task_time`` before the first (§4.6 footnote 6: the designer may give expected times);
-- lambda = ``lambda_factor`` x task_time (§4.6: "two or three times");
+- lambda = ``lambda_factor`` x task_time (§4.6: "two or three times"), but never less than ``min_lambda``: a
+  cleanup load's time varies enormously (ch.5), and with lambda = 3 x a few short loads healthy robots gave up
+  long searches, were penalised and waited; the cleanup then failed (seed 4 with red killed, measured);
 - after a failed trial, and until the next success, delta_fast = theta / task_time: the robot waits its own
   expected time before it tries again, longer after every further failure (the set's slow rate is capped at
   the same value, keeping delta_slow <= delta_fast). After a success its configured rates apply again.
@@ -36,11 +38,14 @@ from teamsim.controllers.lalliance import TaskStatistics
 @dataclass(frozen=True)
 class LearningParams:
     """L-ALLIANCE's learning constants for the learned sets (§4.6; no values are given in the thesis)."""
-    enabled: bool = setting(True, meaning="learn from own trials (L-ALLIANCE); false: plain ALLIANCE, whose "
-                                          "broken-gripper robot stays on move-spill for ever (§3.7.2)")
+    enabled: bool = setting(False, meaning="learn from own trials (L-ALLIANCE), so a robot that keeps failing "
+                                           "gives up; false: plain ALLIANCE, whose broken-gripper robot stays on "
+                                           "move-spill for ever (§3.7.2)")
     failure_penalty: float = setting(2.0, lo=1.0, open_lo=True,
                                      meaning="factor on the attempted time attributed to a failure (> 1)")
     lambda_factor: float = setting(3.0, lo=1.0, meaning="lambda = this x own expected time (§4.6: 'two or three')")
+    min_lambda: float = setting(600.0, lo=0.0, meaning="lambda is never shorter than this, s: task times vary "
+                                                       "enormously (ch.5), and a long search is not a failure")
     prior_task_time: float = setting(200.0, lo=0.0, open_lo=True,
                                      meaning="own expected time before the first trial, s")
     trials_kept: int = setting(5, lo=1, hi=1000, meaning="mu, trials per statistic ('about 5', §4.4.2)")
@@ -88,7 +93,8 @@ class LearnedAcquiescence:
             configured = rates[name]
             expected = self.expected_time(name)
             fast = theta / expected if self.failed_last[name] else configured.delta_fast
-            rates[name] = _Learned(configured, fast, self.params.lambda_factor * expected)
+            lam = max(self.params.lambda_factor * expected, self.params.min_lambda)
+            rates[name] = _Learned(configured, fast, lam)
         return rates
 
     def step(self, time: float, feedback: Mapping[str, bool], messages: Iterable,

@@ -68,7 +68,7 @@ def test_without_radio_every_robot_finds_and_reports_for_itself(tmp_path):
 
 def test_a_robot_with_a_broken_gripper_gives_up_move_spill(tmp_path, capsys):
     """L-ALLIANCE's failure penalty (§4.6): green's gripper breaks at 100 s; it gives move-spill up at lambda
-    (2 x its 40 s prior, set short so that it shows within one mission), is charged twice the time it tried, and
+    (2 x its 40 s prior, no floor: set short so that it shows within one mission), is charged twice the time it tried, and
     waits that long before trying again. The others finish the cleanup."""
     import json
 
@@ -77,6 +77,7 @@ def test_a_robot_with_a_broken_gripper_gives_up_move_spill(tmp_path, capsys):
     learning = "robots.green.controller.behaviour.learning"
     code = main(["run", "hazardous-waste", "--seed", "9", "--out", str(tmp_path), "--run-id", "run",
                  "--set", f"{learning}.prior_task_time=40", "--set", f"{learning}.lambda_factor=2",
+                 "--set", f"{learning}.min_lambda=0", "--set", f"{learning}.enabled=true",
                  "--fault", "break-gripper:green@100"])
     assert code == 0, capsys.readouterr().err
     run_dir = tmp_path / "hazardous-waste" / "run"

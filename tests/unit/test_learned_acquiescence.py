@@ -13,7 +13,7 @@ DT = 0.1
 
 def robot(**learning) -> LearnedAcquiescence:
     core = AllianceRobot("green", [BehaviourSet("move-spill", rates=RATES)])
-    return LearnedAcquiescence(core, ("move-spill",), LearningParams(**learning))
+    return LearnedAcquiescence(core, ("move-spill",), LearningParams(**{"min_lambda": 0.0, "enabled": True, **learning}))
 
 
 def activations(selector: LearnedAcquiescence, until: float, done_after: float | None = None, time: float = 0.0):
@@ -64,6 +64,13 @@ def test_successes_keep_the_configured_rates_and_learn_the_time():
     gaps = [b[0] - a[1] for a, b in zip(spans, spans[1:])]
     assert max(gaps) < 4.0  # back within theta / delta_fast after each success
     assert selector.rates()["move-spill"].lam == pytest.approx(90.0, abs=1.5)  # 3 x 30 s
+
+
+def test_lambda_never_falls_below_its_floor():
+    selector = robot(prior_task_time=10.0, lambda_factor=2.0, min_lambda=50.0)
+    assert selector.rates()["move-spill"].lam == 50.0
+    spans = activations(selector, 60.0)
+    assert spans[0][1] - spans[0][0] == pytest.approx(50.0, abs=0.25)
 
 
 def test_a_success_after_failures_restores_the_fast_rate():
