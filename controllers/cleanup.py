@@ -80,7 +80,8 @@ class CleanupParams:
     # An approach ends within 12 s: 0.3 m of IR range at 6 cm/s plus the blind 4 s; longer means the fingertips
     # saw a robot (Parker's R-2s also took each other's fingers for pucks, §3.8.4).
     gripper: G.GripperParams = field(default_factory=lambda: G.GripperParams(approach_timeout=12.0))
-    # move-spill learns from its own loads (L-ALLIANCE's failure penalty): a robot whose gripper breaks gives it up
+    # move-spill may learn from its own loads (L-ALLIANCE's failure penalty; off by default): then a robot whose
+    # gripper breaks gives it up
     learning: LearningParams = field(default_factory=LearningParams)
 
 

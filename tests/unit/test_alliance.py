@@ -339,19 +339,24 @@ def test_p4_p5_p6_on_traces(mission, radio, seed, fault_time, literal_reset):
                     assert m > previous.motivation[s], f"P4: {name}.{s} at {trace.time}"
 
 
-def test_takeover_after_a_death_within_phi_tau_and_one_period():
-    """Claim 1 (§6.1.2): the robot doing the task dies; its capable teammate takes over in bounded time."""
+def a_dies_at_30_s(rates_a: MotivationRates, rates_b: MotivationRates, task_time: float, until: float):
+    """Robots a and b share task x (radio at 1 Hz, tau = 3 s); a is killed at 30 s. (team, radio, death time)."""
     radio = RadioConfig(rate_hz=1.0)
-    eager = MotivationRates(delta_fast=0.5, delta_slow=1 / 60, phi=60.0, psi=100.0, lam=200.0)
-    calm = replace(eager, delta_fast=0.2)
 
     def make(name, sets):
-        return AllianceRobot(name, [replace(s, rates=eager if name == "a" else calm) for s in sets],
+        return AllianceRobot(name, [replace(s, rates=rates_a if name == "a" else rates_b) for s in sets],
                              AllianceParams(tau=radio.timeout))
 
-    team = AbstractTeam([Task("x")], {"a": {"x": 100.0}, "b": {"x": 100.0}}, make, radio, dt=0.1)
+    team = AbstractTeam([Task("x")], {"a": {"x": task_time}, "b": {"x": task_time}}, make, radio, dt=0.1)
     death = 30.0
-    team.run(150.0, events={death: lambda: team.kill("a")})
+    team.run(until, events={death: lambda: team.kill("a")})
+    return team, radio, death
+
+
+def test_takeover_after_a_death_within_phi_tau_and_one_period():
+    """Claim 1 (§6.1.2): the robot doing the task dies; its capable teammate takes over in bounded time."""
+    eager = MotivationRates(delta_fast=0.5, delta_slow=1 / 60, phi=60.0, psi=100.0, lam=200.0)
+    team, radio, death = a_dies_at_30_s(eager, replace(eager, delta_fast=0.2), task_time=100.0, until=150.0)
     assert team.first_time("a", "x") < 5.0
     takeover = team.first_time("b", "x")
     assert death < takeover <= death + eager.phi + radio.timeout + team.dt
@@ -361,17 +366,9 @@ def test_takeover_after_a_death_within_phi_tau_and_one_period():
 def test_a_silent_claim_lapses_after_tau():
     """The takeover's tau part: with patience phi far longer than the trial, the teammate can only take the task
     over because the dead robot's claim lapses tau after its last message; then it grows at delta_fast."""
-    radio = RadioConfig(rate_hz=1.0)
     patient = MotivationRates(delta_fast=0.25, delta_slow=1 / 2000, phi=1000.0, psi=100.0, lam=500.0)
     slower = replace(patient, delta_fast=0.1)  # b would start after 10 s: it hears a's claim first
-
-    def make(name, sets):
-        return AllianceRobot(name, [replace(s, rates=patient if name == "a" else slower) for s in sets],
-                             AllianceParams(tau=radio.timeout))
-
-    team = AbstractTeam([Task("x")], {"a": {"x": 200.0}, "b": {"x": 200.0}}, make, radio, dt=0.1)
-    death = 30.0
-    team.run(60.0, events={death: lambda: team.kill("a")})
+    team, radio, death = a_dies_at_30_s(patient, slower, task_time=200.0, until=60.0)
     assert team.first_time("a", "x") < team.first_time("b", "x")
     takeover = team.first_time("b", "x")
     # the last message came at most one broadcast period (1 s) before the death
