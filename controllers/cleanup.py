@@ -61,7 +61,17 @@ class CleanupParams:
     follow_speed: float = 0.25  # m/s
     home_leave: float = 2.0  # m: wall-following ends back within home_return of home after going this far
     home_return: float = 0.8
-    wander_leg: float = 30.0  # s per compass direction of find-wander (a 7.9 m room at 0.3 m/s is 26 s)
+    # find-wander (see FindWander): s of driving per compass direction (a 7.9 m room at 0.3 m/s is 26 s), and at
+    # most wander_leg_limit s per direction in all
+    wander_leg: float = 30.0
+    wander_leg_limit: float = 90.0
+    # Blocked for wander_patience during a leg (a teammate driving the same way moves on first), find-wander steps
+    # wander_sidestep to its right and carries on: a wall stays in the way, a robot is passed (a teammate switched
+    # off by the wall ended the leg there and put the goal 1.3 m short). Right is away from the previous leg's
+    # wall, the legs turning right each time. Blocked after wander_sidesteps sidesteps, the leg is at a wall.
+    wander_patience: float = 3.0
+    wander_sidestep: float = 0.5
+    wander_sidesteps: int = 2
     spill_vicinity: float = 1.0  # m from the believed spill centre where sweeping starts
     spill_radius: float = 0.6  # m: sweep lines pass within this of the believed spill centre
     sweep_overshoot: float = 0.6  # m a sweep line runs past its random point
@@ -255,7 +265,14 @@ class FindMethodical(ExtentTracker):
 
 
 class FindWander(ExtentTracker):
-    """Fig. 3-6: drive west, north, east and south, ``wander_leg`` seconds each, stopping at whatever blocks."""
+    """Fig. 3-6: drive west, north, east and south in turn, tracking the extremes reached.
+
+    Parker gives each direction "a fixed time period". Here a leg's clock runs only while the robot drives along
+    it (``wander_leg`` s of driving: more than the room is long), so time lost to teammates in the way does not
+    cut a leg short and put the goal short of the goal zone (measured: three robots wandering from the entrance
+    at once, radio off). A leg also ends at a wall: blocked for ``wander_patience`` it sidesteps to its right and
+    carries on, up to ``wander_sidesteps`` times; blocked once more, what is ahead is the room's extent. A robot
+    in the way is passed, a wall stays. No leg lasts more than ``wander_leg_limit`` s."""
     name = WANDER
     HEADINGS = (math.pi, math.pi / 2, 0.0, -math.pi / 2)
 
@@ -266,21 +283,60 @@ class FindWander(ExtentTracker):
 
     def restart(self) -> None:
         super().restart()
-        self.started: float | None = None
+        self.leg = 0
+        self.leg_began: float | None = None
+        self.driven = 0.0  # s driven along this leg
+        self.last_time: float | None = None
+        self.sidesteps = 0
+        self.sidestep_from: np.ndarray | None = None  # where the current sidestep began
+        self.blocked_since: float | None = None
+
+    def next_leg(self, now: float) -> None:
+        self.leg += 1
+        self.leg_began, self.driven, self.sidesteps, self.sidestep_from, self.blocked_since = now, 0.0, 0, None, None
 
     def __call__(self, obs: Observation) -> Command:
         p = self.params
-        if self.started is None:
-            self.started = obs.time
+        if self.leg_began is None:
+            self.leg_began = obs.time
+        dt = 0.0 if self.last_time is None else obs.time - self.last_time
+        self.last_time = obs.time
         self.track()
-        leg = int((obs.time - self.started) // p.wander_leg)
-        if leg >= len(self.HEADINGS):
+        if self.driven >= p.wander_leg or obs.time - self.leg_began >= p.wander_leg_limit:
+            self.next_leg(obs.time)
+        if self.leg >= len(self.HEADINGS):
             return self.conclude()
-        omega = turn_to(self.estimate.pose, self.HEADINGS[leg], p.drive)
+        heading = self.HEADINGS[self.leg]
+        blocked = min(obs.ir_range[self.tips]) < p.wall_ahead or obs.touch.get("bump_front", 0.0) >= p.drive.bump_force
+        if self.sidestep_from is not None:
+            return self._sidestep(heading - math.pi / 2, blocked)
+        omega = turn_to(self.estimate.pose, heading, p.drive)
         if omega is not None:
             return self.drive(0.0, omega)
-        blocked = min(obs.ir_range[self.tips]) < p.wall_ahead or obs.touch.get("bump_front", 0.0) >= p.drive.bump_force
-        return self.drive(0.0 if blocked else p.drive.cruise)
+        if not blocked:
+            self.blocked_since = None
+            self.driven += dt
+            return self.drive(p.drive.cruise)
+        if self.blocked_since is None:
+            self.blocked_since = obs.time
+        if obs.time - self.blocked_since >= p.wander_patience:
+            if self.sidesteps < p.wander_sidesteps:
+                self.sidesteps += 1
+                self.sidestep_from, self.blocked_since = self.estimate.pose[:2].copy(), None
+            else:
+                self.next_leg(obs.time)  # a wall
+        return self.drive()
+
+    def _sidestep(self, heading: float, blocked: bool) -> Command:
+        """Turn right and drive ``wander_sidestep`` (or until blocked); then the leg's heading is taken again."""
+        p = self.params
+        omega = turn_to(self.estimate.pose, heading, p.drive)
+        if omega is not None:
+            return self.drive(0.0, omega)
+        if blocked or np.hypot(*(self.estimate.pose[:2] - self.sidestep_from)) >= p.wander_sidestep:
+            self.sidestep_from = None
+            return self.drive()
+        return self.drive(p.drive.cruise)
 
 
 class MoveSpill(SetController):

@@ -233,9 +233,18 @@ class HazardousWasteMission(ScenarioMission):
             "find_locations_by": sorted(n for n, r in robots.items()
                                         if any(r["task_time_s"].get(s, 0) > 0 for s in find_sets)),
             "per_robot": {n: {"transports": b.knowledge.transports, "reports": b.knowledge.reports,
-                              "located": b.knowledge.located} for n, b in brains.items()},
+                              "located": b.knowledge.located, **believed_locations(b.knowledge)}
+                          for n, b in brains.items()},
             "task_time_s": {task: round(sum(r["task_time_s"].get(s, 0.0) for r in robots.values()
                                             for s in sets), 3)
                             for task, sets in ((FIND, find_sets), (MOVE, (MOVE,)), (REPORT, (REPORT,)))},
         }
         return at_goal >= target, metrics
+
+
+def believed_locations(knowledge) -> dict:
+    """Where a robot believes the spill, the goal and the entrance are (m, rounded to the cm), if it found them or
+    heard them: a goal believed short of the goal zone explains pucks delivered short of it."""
+    if not knowledge.located:
+        return {}
+    return {k: [round(float(v), 2) for v in getattr(knowledge, k)] for k in ("spill", "goal", "entrance")}

@@ -99,3 +99,81 @@ def test_avoid_backs_off_from_a_front_bump_then_turns_right_and_releases():
     v, omega = avoid(_observation(10.0, None, 0.0, ir=[np.inf, 0.1, np.inf, np.inf]))  # close on the left
     assert v > 0 and omega == 0.0  # not ahead: it moves on, then turns away to the right
     assert avoid(_observation(10.0 + p.back_time + 0.05, None, 0.0))[1] < 0
+
+
+class _Pose:
+    """A perfect pose estimate, for driving a behaviour kinematically."""
+    def __init__(self, x, y, heading):
+        self.pose = np.array([x, y, heading], float)
+
+
+def _tip_range(pose, boxes, half_x=3.96, half_y=1.83, nose=0.2) -> float:
+    """Distance from the jaw's front straight ahead to the first wall or box face (boxes: (x0, x1, y0, y1))."""
+    x, y, heading = pose
+    c, s = math.cos(heading), math.sin(heading)
+    x, y = x + nose * c, y + nose * s
+    hits = [((half_x if c > 0 else -half_x) - x) / c if abs(c) > 1e-9 else math.inf,
+            ((half_y if s > 0 else -half_y) - y) / s if abs(s) > 1e-9 else math.inf]
+    for x0, x1, y0, y1 in boxes:
+        with np.errstate(divide="ignore", invalid="ignore"):
+            tx = sorted(((x0 - x) / c, (x1 - x) / c)) if abs(c) > 1e-9 else ([-math.inf, math.inf] if x0 <= x <= x1
+                                                                             else [math.inf, -math.inf])
+            ty = sorted(((y0 - y) / s, (y1 - y) / s)) if abs(s) > 1e-9 else ([-math.inf, math.inf] if y0 <= y <= y1
+                                                                             else [math.inf, -math.inf])
+        near, far = max(tx[0], ty[0]), min(tx[1], ty[1])
+        if near <= far and near >= 0:
+            hits.append(near)
+    return min(hits)
+
+
+def _wander_east(boxes, seconds=90.0):
+    """Run find-wander's east leg (leg 2) from where its north leg stops, by the west and north walls of the
+    7.92 x 3.66 m room, already facing east, kinematically (0.1 s ticks, perfect pose), until the leg ends; the
+    robot's track and the behaviour."""
+    from teamsim.controllers.cleanup import CleanupParams, FindWander
+    from teamsim.models import build_robot
+
+    robot = build_robot("r2", "blue")
+    params = CleanupParams()
+    estimate = _Pose(-3.5, 1.41, 0.0)
+    knowledge = CleanupKnowledge(report_interval=240.0, home=np.array([-3.2, 0.0]))
+    wander = FindWander(robot, knowledge, estimate, None, params)
+    tips = [robot.ir_sensors.index(n) for n in ("ir_tip_left", "ir_tip_right")]
+
+    def observe(time, ranges):
+        return Observation(time=time, robot="blue", ir_raw=ranges, ir_range=ranges, ir_bearings=robot.ir_bearings,
+                           pose=None)
+
+    wander.leg = 2  # east
+    track = []
+    for tick in range(round(seconds / 0.1)):
+        if wander.leg != 2:
+            break
+        ranges = np.full(len(robot.ir_sensors), np.inf)
+        ranges[tips] = _tip_range(estimate.pose, boxes)
+        command = wander(observe(tick * 0.1, ranges))
+        x, y, heading = estimate.pose
+        estimate.pose = np.array([x + command.v * 0.1 * math.cos(heading), y + command.v * 0.1 * math.sin(heading),
+                                  heading + command.omega * 0.1])
+        track.append(estimate.pose.copy())
+    return np.array(track), wander
+
+
+def test_find_wander_sidesteps_a_robot_in_its_way_but_stops_at_the_wall():
+    """A switched-off teammate by the north wall (0.35 m across at x = 1) is passed with one sidestep to the
+    right, so the east leg still reaches the far wall; without it the leg would end at x < 0.8."""
+    teammate = (1.0, 1.35, 1.2, 1.83)
+    track, wander = _wander_east([teammate])
+    assert track[:, 0].max() > 3.4  # the far wall is at 3.96, the jaw 0.2 m ahead of the pose
+    beside = track[(track[:, 0] > 0.9) & (track[:, 0] < 1.45), 1]
+    assert beside.size and (beside < 1.2 - 0.1).all()  # it passed the teammate on its south side (right of east)
+    assert (beside > 1.41 - 0.5 - 0.1).all()  # by one sidestep, not more
+    # The leg ends at the wall (second sidestep spent, blocked again), not at the time limit.
+    assert wander.leg == 3 and track[-1, 0] > 3.4 and len(track) < 600
+
+
+def test_find_wander_without_obstacles_drives_the_leg_straight_to_the_wall():
+    track, _ = _wander_east([])
+    assert track[:, 0].max() > 3.4
+    on_the_way = track[track[:, 0] < 3.3]
+    assert np.abs(on_the_way[:, 1] - 1.41).max() < 1e-6  # no sidestep before the wall: nothing was in the way
