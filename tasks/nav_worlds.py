@@ -177,6 +177,7 @@ class KinematicRobot:
     ir_count: int
     ir_range: float = 1.5
     centre_offset: float = 0.0  # the circle's centre ahead of the pose's reference point
+    sensor_radius: tuple[float, ...] = ()  # each sensor's distance from the centre; () puts them on the circle
     wheelbase: float = 0.5  # tricycle only, as TricycleDims assumes
     steer_max: float = math.radians(60)
     steer_rate_max: float = 1.0
@@ -185,37 +186,54 @@ class KinematicRobot:
 @dataclass(frozen=True)
 class KinematicRun:
     reached: bool  # the controller reported "arrived"
-    collided: bool  # the enclosing circle touched a box or wall
+    collided: bool  # the enclosing circle touched a box or wall (and the run ended there: on_contact="end")
     time: float  # s simulated
     min_clearance: float  # m, between the enclosing circle and the nearest box or wall
     decision_times: np.ndarray  # s of wall time per controller call
+    travelled: float = 0.0  # m along the path of the pose's reference point
+    touches: int = 0  # control ticks whose motion was refused because it would have touched (on_contact="stop")
+    pose: tuple[float, float, float] = (0.0, 0.0, 0.0)  # where the run ended
 
 
 def kinematic_run(world: NavWorld, controller, robot: KinematicRobot, duration: float,
-                  control_dt: float = 0.1, substeps: int = 5) -> KinematicRun:
+                  control_dt: float = 0.1, substeps: int = 5, on_contact: str = "end") -> KinematicRun:
     """Drive ``controller`` from the world's start with ideal IR ranges and exact positioning fixes every control
     tick. The command is clipped and slewed by the drive limits as the locomotion does; a tricycle's front wheel
     turns towards atan(omega L / v) at its steering rate and the robot then follows the bicycle model, a
-    differential drive follows the unicycle model."""
+    differential drive follows the unicycle model.
+
+    ``on_contact`` says what a motion that would make the enclosing circle touch a box or wall does: "end" ends
+    the run there as a collision; "stop" refuses that tick's motion and halts the robot (v = omega = 0), the way a
+    bumper stops a real robot and a touch stops (but does not end) a physics run."""
+    if on_contact not in ("end", "stop"):
+        raise ValueError(f"on_contact={on_contact!r}: allowed: end, stop")
     lim = robot.limits
     x, y, heading = world.start
     v = omega = steer = 0.0
     bearings = 2 * np.pi * np.arange(robot.ir_count) / robot.ir_count
+    sensor_radius = np.asarray(robot.sensor_radius or (robot.radius,) * robot.ir_count, float)
     decision_times = []
     min_clearance = math.inf
+    travelled, touches = 0.0, 0
     steps = round(duration / control_dt)
+
+    def run(reached: bool, collided: bool, time_end: float) -> KinematicRun:
+        return KinematicRun(reached, collided, time_end, min_clearance, np.array(decision_times), travelled,
+                            touches, (x, y, heading))
+
     for tick in range(steps):
         time_now = tick * control_dt
         cx, cy = x + robot.centre_offset * math.cos(heading), y + robot.centre_offset * math.sin(heading)
         directions = np.column_stack([np.cos(heading + bearings), np.sin(heading + bearings)])
-        ranges = ray_ranges(world, np.array([cx, cy]) + robot.radius * directions, directions, robot.ir_range)
+        ranges = ray_ranges(world, np.array([cx, cy]) + sensor_radius[:, None] * directions, directions,
+                            robot.ir_range)
         observation = Observation(time=time_now, robot="kinematic", ir_raw=ranges, ir_range=ranges,
                                   ir_bearings=bearings, pose=PoseFix(x, y, heading, time_now))
         began = time_module.perf_counter()
         command = controller(observation)
         decision_times.append(time_module.perf_counter() - began)
         if command.behaviour == "arrived":
-            return KinematicRun(True, False, time_now, min_clearance, np.array(decision_times))
+            return run(True, False, time_now)
         v += float(np.clip(np.clip(command.v, -lim.v_max, lim.v_max) - v, -lim.accel_max * control_dt,
                            lim.accel_max * control_dt))
         omega += float(np.clip(np.clip(command.omega, -lim.omega_max, lim.omega_max) - omega,
@@ -228,13 +246,21 @@ def kinematic_run(world: NavWorld, controller, robot: KinematicRobot, duration: 
             steer += min(max(wanted - steer, -step), step)
             turn_rate = v * math.tan(steer) / robot.wheelbase
         dt = control_dt / substeps
+        nx, ny, nheading = x, y, heading
         for _ in range(substeps):
-            x += v * dt * math.cos(heading)
-            y += v * dt * math.sin(heading)
-            heading += turn_rate * dt
-        heading = (heading + math.pi) % (2 * math.pi) - math.pi
-        cx, cy = x + robot.centre_offset * math.cos(heading), y + robot.centre_offset * math.sin(heading)
-        min_clearance = min(min_clearance, clearance(world, cx, cy) - robot.radius)
-        if min_clearance < 0:
-            return KinematicRun(False, True, time_now + control_dt, min_clearance, np.array(decision_times))
-    return KinematicRun(False, False, steps * control_dt, min_clearance, np.array(decision_times))
+            nx += v * dt * math.cos(nheading)
+            ny += v * dt * math.sin(nheading)
+            nheading += turn_rate * dt
+        nheading = (nheading + math.pi) % (2 * math.pi) - math.pi
+        cx, cy = nx + robot.centre_offset * math.cos(nheading), ny + robot.centre_offset * math.sin(nheading)
+        gap = clearance(world, cx, cy) - robot.radius
+        if gap < 0 and on_contact == "stop":
+            touches += 1
+            v = omega = 0.0
+            continue
+        travelled += math.hypot(nx - x, ny - y)
+        x, y, heading = nx, ny, nheading
+        min_clearance = min(min_clearance, gap)
+        if gap < 0:
+            return run(False, True, time_now + control_dt)
+    return run(False, False, steps * control_dt)

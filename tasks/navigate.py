@@ -18,13 +18,13 @@ import numpy as np
 from teamsim.config import ConfigError, setting
 from teamsim.controllers import dynamic_window as dw
 from teamsim.controllers.astar import PlannerParams, plan_on_grid
-from teamsim.models import ROBOT_KINDS
+from teamsim.models import ROBOT_KINDS, build_robot
 from teamsim.models.arenas import Box
 from teamsim.models.robot import RobotModel, TricycleSpec
 from teamsim.scenario import (MAX_EXTENT, Arena, BoxObstacle, RobotEntry, Scenario, image_boxes, obstacles,
                               scene_of)
 from teamsim.tasks.base import Scene, ScenarioMission
-from teamsim.tasks.nav_worlds import NavWorld, NavWorldParams, random_world
+from teamsim.tasks.nav_worlds import KinematicRobot, NavWorld, NavWorldParams, kinematic_run, random_world
 
 # Table 3.1's simulated robots: kind and the dimensions that differ from the kind's defaults.
 TABLE_3_1 = {
@@ -119,21 +119,7 @@ class NavigateMission(ScenarioMission):
 
     def controller(self, robot: RobotModel, scene: Scene, rng: np.random.Generator):
         settings, world = scene.scenario.robots[robot.name].controller, scene.info["nav_world"]
-        offset = 0.0
-        kwargs = {}
-        if isinstance(robot.drive, TricycleSpec):
-            # The tricycle's pose is its rear axle; its pentagon's centre is half a wheelbase ahead.
-            offset = robot.drive.wheelbase / 2
-            kwargs.update(centre_offset=offset, steering=robot.drive)
-        # The pentagon's and the rectangle's sensors sit on their sides, nearer the centre than the enclosing
-        # circle (by up to 19 % of its radius on the pentagon, 37 % on Robot C's rectangle).
-        kwargs["sensor_radius"] = ir_sensor_radii(robot, offset)
-        if settings.method == "HRDK":
-            kwargs["known_map"] = world.known_map()
-        elif settings.method == "HRDU":
-            kwargs["grid"] = world.unexplored_map()
-        controller = METHODS[settings.method](robot.limits, robot.kind, robot.footprint_radius, world.goal,
-                                                **kwargs)
+        controller = navigation_controller(settings.method, robot, world)
         scene.info["controller"] = controller
         return controller
 
@@ -145,26 +131,53 @@ class NavigateMission(ScenarioMission):
         return bool(controller.arrived)
 
     def outcome(self, world) -> tuple[bool, dict]:
-        nav_world = world.scene.info["nav_world"]
         name = world.scene.info["robot"]
         robot = world.robots[name]
-        x, y, _ = world.pose(robot)
-        reached = self._arrived(world) and math.dist((x, y), nav_world.goal) <= 0.5 + robot.model.footprint_radius
-        travelled = float(world.odometry()[name])
-        planned = optimal_path_length(nav_world, robot.model.footprint_radius)
-        nav_time = world.time
-        v_max = robot.model.limits.v_max
-        metrics = {
-            "success": reached,
-            "nav_time": round(nav_time, 3),
-            "path_length": round(travelled, 3),
-            "planned_length": round(planned, 3),
-            "path_index": round(planned / travelled, 4) if reached and travelled > 0 else 0.0,
-            "avg_velocity": round(travelled / nav_time / v_max, 4) if nav_time > 0 else 0.0,
-            "density": round(nav_world.density, 4),
-            "final_distance_to_goal": round(math.dist((x, y), nav_world.goal), 3),
-        }
-        return reached, metrics
+        metrics = nav_metrics(world.scene.info["nav_world"], robot.model, self._arrived(world), world.pose(robot),
+                              float(world.odometry()[name]), world.time)
+        return metrics["success"], metrics
+
+
+def centre_offset(robot: RobotModel) -> float:
+    """How far the robot's physical centre lies ahead of its pose's reference point: the tricycle's pose is its
+    rear axle, its pentagon's centre half a wheelbase ahead."""
+    return robot.drive.wheelbase / 2 if isinstance(robot.drive, TricycleSpec) else 0.0
+
+
+def navigation_controller(method: str, robot: RobotModel, world: NavWorld):
+    """The navigation method ``method`` for ``robot`` in ``world`` (HRDK gets the known map, HRDU an unexplored
+    one)."""
+    offset = centre_offset(robot)
+    kwargs = {}
+    if isinstance(robot.drive, TricycleSpec):
+        kwargs.update(centre_offset=offset, steering=robot.drive)
+    # The pentagon's and the rectangle's sensors sit on their sides, nearer the centre than the enclosing
+    # circle (by up to 19 % of its radius on the pentagon, 37 % on Robot C's rectangle).
+    kwargs["sensor_radius"] = ir_sensor_radii(robot, offset)
+    if method == "HRDK":
+        kwargs["known_map"] = world.known_map()
+    elif method == "HRDU":
+        kwargs["grid"] = world.unexplored_map()
+    return METHODS[method](robot.limits, robot.kind, robot.footprint_radius, world.goal, **kwargs)
+
+
+def nav_metrics(nav_world: NavWorld, robot: RobotModel, arrived: bool, pose, travelled: float,
+                nav_time: float) -> dict:
+    """§3.6.2's measures of one trial: success (stopped at the goal), NT, PI (planned over travelled length, on
+    success) and AV (mean speed over v_gmax)."""
+    x, y = pose[0], pose[1]
+    reached = arrived and math.dist((x, y), nav_world.goal) <= 0.5 + robot.footprint_radius
+    planned = optimal_path_length(nav_world, robot.footprint_radius)
+    return {
+        "success": bool(reached),
+        "nav_time": round(nav_time, 3),
+        "path_length": round(travelled, 3),
+        "planned_length": round(planned, 3),
+        "path_index": round(planned / travelled, 4) if reached and travelled > 0 else 0.0,
+        "avg_velocity": round(travelled / nav_time / robot.limits.v_max, 4) if nav_time > 0 else 0.0,
+        "density": round(nav_world.density, 4),
+        "final_distance_to_goal": round(math.dist((x, y), nav_world.goal), 3),
+    }
 
 
 def nav_world_of(scenario: Scenario) -> NavWorld:
@@ -195,3 +208,36 @@ def optimal_path_length(nav_world, robot_radius: float) -> float:
     path, result = plan_on_grid(nav_world.known_map(), nav_world.start[:2], nav_world.goal, PlannerParams(),
                                 robot_radius)
     return float(np.hypot(*np.diff(path, axis=0).T).sum()) if result.reached else math.nan
+
+
+# -- without physics -------------------------------------------------------------------------------------------------
+def kinematic_robot(robot: RobotModel) -> KinematicRobot:
+    """The physics-free stand-in of a robot model: its drive limits, enclosing circle, IR ring with the sensors
+    where the model puts them, and (a tricycle) its wheelbase and steering limits."""
+    offset = centre_offset(robot)
+    radii = tuple(float(r) for r in ir_sensor_radii(robot, offset))
+    if isinstance(robot.drive, TricycleSpec):
+        return KinematicRobot("tricycle", robot.limits, robot.footprint_radius, len(radii), centre_offset=offset,
+                              sensor_radius=radii, wheelbase=robot.drive.wheelbase, steer_max=robot.drive.steer_max,
+                              steer_rate_max=robot.drive.steer_rate_max)
+    return KinematicRobot(robot.kind, robot.limits, robot.footprint_radius, len(radii), sensor_radius=radii)
+
+
+def kinematic_trial(config) -> dict:
+    """A navigate trial without physics (``teamsim.tasks.nav_worlds.kinematic_run``): the same world, robot
+    dimensions, controller and measures as in physics, with ideal IR ranges and exact positioning. A motion that
+    would touch an obstacle is refused and the robot halted (a touch stops, not ends, a physics run too); the
+    number of such ticks is reported as ``touches``. Returns a summary shaped like ``run_trial``'s."""
+    params: NavigateParams = config.params
+    params.check()
+    rng = np.random.default_rng(params.world_seed if params.world_seed >= 0 else config.seed)
+    world = random_world(params.density, rng, NavWorldParams())
+    kind, options = robot_of(params.robot)
+    model = build_robot(kind, "red", **options)
+    controller = navigation_controller(params.controller, model, world)
+    run = kinematic_run(world, controller, kinematic_robot(model), time_limit(params.density), on_contact="stop")
+    metrics = nav_metrics(world, model, run.reached, run.pose, run.travelled, run.time)
+    metrics["touches"] = run.touches
+    return {"mission": "navigate", "seed": config.seed, "run_id": config.run_id,
+            "status": "completed" if metrics["success"] else "failed", "completed": metrics["success"],
+            "sim_time_s": run.time, "metrics": metrics}

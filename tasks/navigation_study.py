@@ -6,6 +6,11 @@ cell reports NT (mean navigation time of successful runs), PI (mean path index o
 (success rate), AV (mean average velocity over v_gmax of successful runs) and OS = (SR + PI + AV) / 3 (3.41).
 Against FRC it reports the ratio of mean per-trial OS (a failed trial scores PI = AV = 0) and of NT (trials
 both finished), with paired two-sided t-test p-values.
+
+Trials run without physics by default (``backend="kinematic"``: ideal IR ranges, exact positions, unicycle or
+bicycle kinematics, ``teamsim.tasks.navigate.kinematic_trial``), which is what the thesis's own simulations were
+(§3.6: MATLAB, no dynamics) and what lets the reduced default run in minutes; ``backend="physics"`` runs every
+trial as a MuJoCo ``navigate`` mission (about four times slower).
 """
 from __future__ import annotations
 
@@ -22,10 +27,29 @@ from teamsim.plots import grouped_bars
 from teamsim.recording import write_atomic, write_csv
 from teamsim.stats import paired_t_test
 from teamsim.sweep import run_trials
-from teamsim.tasks.navigate import METHODS, TABLE_3_1, NavigateParams, time_limit
+from teamsim.tasks.navigate import METHODS, TABLE_3_1, NavigateParams, kinematic_trial, time_limit
 
 COLUMNS = ("robot", "density", "controller", "trial", "seed", "world_seed", "success", "nav_time", "path_index",
-           "avg_velocity", "path_length", "planned_length", "status")
+           "avg_velocity", "path_length", "planned_length", "touches", "status")
+BACKENDS = {"kinematic": kinematic_trial, "physics": None}  # None: run_trial, the MuJoCo mission
+
+# What Figs 3.10-3.15 report for each method and robot (spec §2, table of reported numbers), for the report's
+# cells; the thesis gives no per-cell values in its text.
+THESIS_FIGURES = {
+    ("FRC", "A"): "SR > 88 %; OS > 0.75", ("FRC", "B"): "PI > 0.83; SR > 88 %; OS > 0.86",
+    ("FRC", "C"): "PI > 0.83; SR 80 % at 20 %; OS > 0.77",
+    ("HRDK", "A"): "SR > 94 %; OS 0.73-0.97", ("HRDK", "B"): "PI > 0.89; SR > 94 %; OS 0.73-0.97",
+    ("HRDK", "C"): "PI > 0.89; OS 0.73-0.97",
+    ("HRDU", "A"): "NT 46-136 s; PI > 0.59; SR > 81 %; OS > 0.68",
+    ("HRDU", "B"): "NT 46-136 s; PI > 0.80; SR 100 %; OS > 0.85",
+    ("HRDU", "C"): "NT 46-136 s; PI > 0.74; SR > 65 %; OS > 0.77",
+    ("ODW", "A"): "PI < 0.48; SR < 5 %; AV > 0.53", ("ODW", "B"): "PI < 0.48; AV > 0.53; OS > 0.5 only at 15-20 %",
+    ("ODW", "C"): "PI < 0.48; SR < 5 %; AV > 0.53",
+    ("ODWDS", "A"): "PI 0.28-0.50 at 15-20 %; AV > 0.70; OS > 0.51",
+    ("ODWDS", "B"): "PI > 0.65; SR > 94 %; AV > 0.70; OS > 0.78", ("ODWDS", "C"): "PI > 0.65; AV > 0.70; OS > 0.64",
+    ("RFRC", "A"): "SR >= 76 %; OS 0.70-0.94", ("RFRC", "B"): "PI > 0.81; SR > 91 %; OS 0.70-0.94",
+    ("RFRC", "C"): "PI > 0.81; SR >= 75 %; OS 0.70-0.94",
+}
 
 
 @dataclass
@@ -37,6 +61,11 @@ class NavigationStudy:
     workers: int | None = None
     out: Path = Path("renders/study-navigation")
     seed: int = 0
+    backend: str = "kinematic"  # or "physics" (see the module's docstring)
+
+    def __post_init__(self) -> None:
+        if self.backend not in BACKENDS:
+            raise ValueError(f"backend={self.backend!r}: allowed: {', '.join(BACKENDS)}")
 
 
 def world_seed(study: NavigationStudy, density: float, trial: int) -> int:
@@ -72,7 +101,8 @@ def result_row(config: TrialConfig, summary: dict) -> dict:
             "success": bool(metrics.get("success", False)), "nav_time": metrics.get("nav_time", math.nan),
             "path_index": metrics.get("path_index", math.nan), "avg_velocity": metrics.get("avg_velocity", math.nan),
             "path_length": metrics.get("path_length", math.nan),
-            "planned_length": metrics.get("planned_length", math.nan), "status": summary.get("status")}
+            "planned_length": metrics.get("planned_length", math.nan), "touches": metrics.get("touches", ""),
+            "status": summary.get("status")}
 
 
 def trial_os(row: dict) -> float:
@@ -123,7 +153,8 @@ def compare(cells: dict, robot: str, density: float, controller: str) -> dict:
 
 def run_study(study: NavigationStudy) -> Path:
     configs = trial_configs(study)
-    summaries = run_trials(configs, workers=study.workers)
+    run = BACKENDS[study.backend]
+    summaries = run_trials(configs, workers=study.workers, **({"run": run} if run else {}))
     rows = [result_row(c, s) for c, s in zip(configs, summaries)]
     study.out.mkdir(parents=True, exist_ok=True)
     write_results(study.out / "results.csv", rows)
@@ -234,7 +265,7 @@ def write_report(study: NavigationStudy, rows: list[dict]) -> None:
     cells = cells_of(rows)
     found = orderings(study, cells)
     lines = ["# Navigation study (Chand ch.3) re-run in teamsim", "",
-             f"{study.trials} trials per cell (the thesis: 100); robots {', '.join(study.robots)}; densities "
+             f"{study.trials} trials per cell (the thesis: 100), {study.backend} backend; robots {', '.join(study.robots)}; densities "
              f"{', '.join(f'{d:.0%}' for d in study.densities)}; controllers {', '.join(study.controllers)}. "
              "Trial k at a density uses the same world for every robot and controller. "
              "Per-trial rows: `results.csv`.", "", "## Orderings against the thesis", "",
@@ -251,15 +282,16 @@ def write_report(study: NavigationStudy, rows: list[dict]) -> None:
               "NT, PI and AV are means over successful trials; ratios and p-values are against FRC on the same "
               f"worlds (paired two-sided t-test). A failed trial stalled if its average velocity stayed under "
               f"{STALLED:.0%} of v_gmax, and wandered otherwise.", "",
-              "| robot | density | controller | NT (s) | PI | SR | AV | OS | OS/FRC | p | NT/FRC | p | failures |",
-              "|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
+              "| robot | density | controller | NT (s) | PI | SR | AV | OS | OS/FRC | p | NT/FRC | p | failures | "
+              "thesis (Figs 3.10-3.15) |",
+              "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for (robot, density, controller), cell in sorted(cells.items()):
         vs = compare(cells, robot, density, controller) if controller != "FRC" and (robot, density, "FRC") in cells \
             else {"os_ratio": math.nan, "os_p": math.nan, "nt_ratio": math.nan, "nt_p": math.nan}
         lines.append(f"| {robot} | {density:.0%} | {controller} | {cell.mean('nav_time'):.1f} | "
                      f"{cell.mean('path_index'):.2f} | {cell.sr:.0%} | {cell.mean('avg_velocity'):.2f} | "
                      f"{cell.os:.2f} | {vs['os_ratio']:.2f} | {vs['os_p']:.3f} | {vs['nt_ratio']:.2f} | "
-                     f"{vs['nt_p']:.3f} | {failure_kinds(cell)} |")
+                     f"{vs['nt_p']:.3f} | {failure_kinds(cell)} | {THESIS_FIGURES.get((controller, robot), '')} |")
     failures = [r for r in rows if r["status"] not in ("completed", "failed")]
     if failures:
         lines += ["", f"{len(failures)} trials ended in error or instability: see their summaries under trials/."]

@@ -77,6 +77,9 @@ def _build_parser() -> argparse.ArgumentParser:
     navigation.add_argument("--workers", type=_positive_int("--workers"))
     navigation.add_argument("--seed", type=int)
     navigation.add_argument("--out", type=Path, default=Path("renders/study-navigation"))
+    navigation.add_argument("--backend", choices=("kinematic", "physics"),
+                            help="kinematic (default: no dynamics, as the thesis simulated; minutes) or physics "
+                                 "(every trial a MuJoCo navigate mission)")
 
     two_tier = studies.add_parser("two-tier-astar", help="Chand ch.4: memory-constrained vs monolithic A*")
     two_tier.add_argument("--trials", type=_positive_int("--trials"), help="worlds per size and density")
@@ -161,7 +164,8 @@ def cmd_study(args) -> int:
         if args.densities and not all(0.0 < d <= 0.3 for d in args.densities):
             raise ConfigError("--densities: each must be in (0, 0.3]")
         study = study_from_args(robots=args.robots, densities=args.densities, controllers=args.controllers,
-                                trials=args.trials, workers=args.workers, out=args.out, seed=args.seed)
+                                trials=args.trials, workers=args.workers, out=args.out, seed=args.seed,
+                                backend=args.backend)
         out = run_study(study)
         print(f"wrote {out / 'report.md'} and {out / 'results.csv'}")
     elif args.study == "two-tier-astar":

@@ -148,3 +148,25 @@ def test_kinematic_tricycle_turns_on_its_steering_circle():
     assert not run.collided and not run.reached
     assert run.time == pytest.approx(60.0)
     assert 0.0 < run.min_clearance < 0.2
+
+
+def test_kinematic_run_that_stops_on_contact_halts_at_the_wall_and_counts_the_touches():
+    w = empty_world()
+    robot = KinematicRobot("diffdrive", LIMITS, radius=0.35, ir_count=10)
+    run = kinematic_run(w, Constant(0.5, 0.0), robot, duration=60.0, on_contact="stop")
+    assert not run.collided and not run.reached
+    assert run.time == pytest.approx(60.0)
+    assert run.min_clearance >= 0.0
+    # It stopped where the next tick's motion would have touched: within one tick's travel of the walls, and the
+    # path it travelled is the straight descent from the start to there.
+    assert run.min_clearance < 0.5 * 0.1
+    assert run.touches > 100
+    assert run.travelled == pytest.approx(math.dist(w.start[:2], run.pose[:2]), rel=1e-6)
+    x, y, _ = run.pose
+    assert clearance(w, x, y) - 0.35 == pytest.approx(run.min_clearance)
+
+
+def test_kinematic_run_rejects_an_unknown_contact_rule():
+    with pytest.raises(ValueError, match="on_contact='bounce': allowed: end, stop"):
+        kinematic_run(empty_world(), Constant(0.0, 0.0), KinematicRobot("diffdrive", LIMITS, 0.35, 10), 1.0,
+                      on_contact="bounce")
