@@ -186,6 +186,57 @@ class Decision:
     v_min: float  # (3.23)'s v_min, kept for its hysteresis
 
 
+# ---------------------------------------------------------------------- single equations, as pure functions
+
+
+def curvature_in_range(v: np.ndarray, omega: np.ndarray, c_min: float, c_max: float) -> np.ndarray:
+    """The factor (c_cd <= c_max)(c_cd >= c_min) of (3.28)-(3.30), with c_cd = omega_cd / v_cd, and CC1's
+    NOT((v_cd = 0)(omega_cd != 0)) [RECON, module notes]: a candidate with v_cd = 0 has no curvature and passes
+    only as a stop (omega_cd = 0), never as a point turn. Alone, it is the check the original window (ODW, ODWDS)
+    makes for a tricycle, like CC_D."""
+    still = np.abs(v) < 1e-9
+    curvature = omega / np.where(still, 1.0, v)
+    return np.where(still, np.abs(omega) < 1e-9, (curvature >= c_min - 1e-9) & (curvature <= c_max + 1e-9))
+
+
+def tricycle_curvature_constraint(v_c: float, v: np.ndarray, omega: np.ndarray, c_min: float,
+                                  c_max: float) -> np.ndarray:
+    """(3.32) CC_T = (CC1 | CC2 | CC3) CC4 per candidate (v_cd, omega_cd), for current linear velocity v_c [RECON]:
+    CC1 (3.28) = curvature in range and not a point turn (``curvature_in_range``); CC2 (3.29) = curvature in range,
+    v_c > 0, v_cd < 0 and CC3 (3.30) = curvature in range, v_c < 0, v_cd > 0 are then special cases of CC1; CC4
+    (3.31) = NOT(v_c = 0 and v_cd = 0), no deadlock standing still."""
+    still = np.abs(v) < 1e-9
+    return curvature_in_range(v, omega, c_min, c_max) & ~(still & (abs(v_c) < 1e-9))
+
+
+def can_stop_turning(dc: np.ndarray, omega: np.ndarray, alpha_min: float) -> np.ndarray:
+    """(3.34) ST_omega: DC_cd > omega_cd^2 / (2 alpha_min), as printed (mixed units), tested only where DC_cd > 0."""
+    return (dc > 0) & (dc > omega ** 2 / (2 * alpha_min))
+
+
+def secondary_objective_tricycle(heading_term: np.ndarray, dc: np.ndarray, st_v: np.ndarray,
+                                 params: DynamicWindowParams) -> np.ndarray:
+    """(3.36) o_dwst, the tricycle FRC's objective for candidates that cannot stop, [RECON, module notes]: its
+    CL_ob case alpha_2 h DC_cd^2 / DC_cdmax^2 for every candidate with NOT ST_v (a CL_ob candidate's DC_cd already
+    carries DCF), -1 otherwise. ``heading_term`` h = 1 - |(theta_tmod - theta_c) - omega_cd t| / pi."""
+    return np.where(~st_v, params.alpha2 * heading_term * dc ** 2 / params.dc_max ** 2, INVALID)
+
+
+def secondary_objective_differential(heading_term: np.ndarray, dc: np.ndarray, st_v: np.ndarray,
+                                     st_w: np.ndarray, v_c: float, params: DynamicWindowParams) -> np.ndarray:
+    """(3.37), the differential drive's secondary objective [RECON, module notes]: on its printed conditions,
+    NOT ST_v and (NOT(v_c = 0) or ST_omega), the value of ``secondary_objective_tricycle``; -1 otherwise."""
+    standing = abs(v_c) < 1e-9
+    return np.where(~st_v & (~standing | st_w), params.alpha2 * heading_term * dc ** 2 / params.dc_max ** 2,
+                    INVALID)
+
+
+def secondary_objective_reduced(heading_term: np.ndarray, st_v: np.ndarray,
+                                params: DynamicWindowParams) -> np.ndarray:
+    """(3.40), RFRC's tricycle secondary objective, as printed: alpha_2 h if NOT ST_v, -1 otherwise."""
+    return np.where(~st_v, params.alpha2 * heading_term, INVALID)
+
+
 class DynamicWindow:
     """One drive's modified dynamic window; ``decide`` is a pure function of its arguments."""
 
@@ -411,7 +462,7 @@ class DynamicWindow:
         if self.tricycle:
             st_w = np.ones(v.size, bool)  # §3.5: tricycles check ST_v only
         else:
-            st_w = (dc > 0) & (dc > omega ** 2 / (2 * alpha_min))  # (3.34)
+            st_w = can_stop_turning(dc, omega, alpha_min)  # (3.34)
 
         # The heading turned by the time a turn at omega_cd has been stopped at the drive's angular limit.
         turned = omega * self.dt + omega * np.abs(omega) / (2 * lim.angular_accel_max)
@@ -437,15 +488,12 @@ class DynamicWindow:
         backwards = state.v > 0 or (state.v == 0 and d_obfr <= d_obrr)
         v_oppose = v_window[0] if backwards else v_window[1]
         at_oppose = np.isclose(v, v_oppose)
-        heading_only = p.alpha2 * heading_term
-        away = heading_only * dc ** 2 / p.dc_max ** 2  # (3.36)'s second case, for every candidate [RECON]
         if self.tricycle and self.method is Method.FRC:  # (3.36)
-            secondary = np.where(~st_v, away, INVALID)
+            secondary = secondary_objective_tricycle(heading_term, dc, st_v, p)
         elif self.tricycle:  # (3.40)
-            secondary = np.where(~st_v, heading_only, INVALID)
+            secondary = secondary_objective_reduced(heading_term, st_v, p)
         else:  # (3.37)
-            standing = abs(state.v) < 1e-9
-            secondary = np.where(~st_v & (~standing | st_w), away, INVALID)
+            secondary = secondary_objective_differential(heading_term, dc, st_v, st_w, state.v, p)
         secondary = np.where(admissible & at_oppose, secondary, INVALID)
         best = int(np.argmax(secondary))
         if secondary[best] > INVALID:
@@ -480,11 +528,10 @@ class DynamicWindow:
         c_min, c_max = self.curvature_limits(state.steer)
         still = np.abs(v) < 1e-9
         curvature = omega / np.where(still, 1.0, v)
-        in_range = np.where(still, np.abs(omega) < 1e-9, (curvature >= c_min - 1e-9) & (curvature <= c_max + 1e-9))
         if self.method.modified:
-            cc = in_range & ~(still & (abs(state.v) < 1e-9))  # CC_T = CC1 CC4 [RECON]
+            cc = tricycle_curvature_constraint(state.v, v, omega, c_min, c_max)  # CC_T = CC1 CC4 [RECON]
         else:
-            cc = in_range  # ODW, ODWDS: like CC_D
+            cc = curvature_in_range(v, omega, c_min, c_max)  # ODW, ODWDS: like CC_D
         if self.method is not Method.FRC:
             return cc, np.zeros(v.size, bool)
         bearing = np.arctan2(points[:, 1], points[:, 0])
