@@ -26,9 +26,15 @@ Choices where the thesis is silent (also in docs/decisions.md):
 
 - "Rank the capable robots ... based on VOTSWS_ij for all tasks that they are capable of performing": by the
   sum over those tasks, so a robot that can take more of them ranks higher (fewer managers, step 4's aim).
-- Exact ties in a ranking go to the robot earlier in the robot file: MATLAB's sort is stable and §7.4 breaks
-  the explorer ties of Fig 7.16 by lowest ID. (Under Table 7.1's W9 every candidate manager ties; §7.3's
-  report of the same managers as under W1-W8 cannot hold by this rule in robot sets (c) and (d).)
+- Ties in a ranking (equal within ``TIE_TOLERANCE`` = 1e-9, see :func:`rank`) go to the robot earlier in the
+  robot file: MATLAB's sort is stable and §7.4 breaks the planner tie under W9 and the explorer ties of Fig 7.16
+  by lowest ID. Managers get the same rule, although under Table 7.1's W9 (communication only) R1 and R2 tie
+  exactly and §7.3 reports the same managers as under W1-W8: no ID order can give that in all five robot sets,
+  because R1 ranks first under W1-W8 in sets (b) and (e) and R2 in (c) and (d) (with Table 7.4's scores as with
+  ours), so the lowest ID gives R1 the harder task in (c) and (d). A score-based second key (e.g. the ranking
+  under equal weights) would make the managers stable, but the spec names none, and used for workers too it
+  would contradict §7.4's own lowest-ID outcomes (set (b), one explorer, W7: R3 over R5, whose equal-weight
+  value is higher). So it is not used; docs/decisions.md records the disagreement.
 - A combination's VSW is the mean of its tasks' VSW; its processor class must be common to its tasks; its size
   is the one size a task names (two different sizes cannot combine).
 - n_1cp of (5.5) is the number of management tasks. CO multiplies only combinations of two or more tasks. When
@@ -101,9 +107,29 @@ class Suitability:
 
 
 
-def rank(robots, values) -> list:
-    """``robots`` (indices) sorted by ``values`` descending; exact ties keep file order."""
-    return [r for _, r in sorted(zip(values, robots), key=lambda x: (-x[0], x[1]))]
+# Values closer than this are a tie. FIS outputs lie in [0, 1]; round-off is ~1e-16, and the smallest real gap in
+# the ch.7 experiments is 7e-6 (robot set (d), planner, W4: R4 over R5).
+TIE_TOLERANCE = 1e-9
+
+
+def rank(robots, values, tolerance: float = TIE_TOLERANCE) -> list:
+    """``robots`` (indices) sorted by ``values`` descending; ties keep file order (lowest index first).
+
+    A tie is equality within ``tolerance``, not bit equality: a value that is mathematically the same for two
+    robots (same VOTS on every weighted resource, same TD) may differ in the last bits, and a 1e-16 difference
+    must not overrule the thesis's tie-break, the lowest ID (§7.4: the planner under W9, the one-explorer
+    choices of Fig 7.16). Robots are grouped from the top: a robot joins the current group while its value is
+    within ``tolerance`` of the group's best, and each group is then put in file order."""
+    ordered = sorted(zip(values, robots), key=lambda x: (-x[0], x[1]))
+    out, group, top = [], [], None
+    for value, robot in ordered:
+        if group and top - value > tolerance:
+            out += sorted(group)
+            group = []
+        if not group:
+            top = value
+        group.append(robot)
+    return out + sorted(group)
 
 
 @dataclass(frozen=True)

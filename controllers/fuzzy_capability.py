@@ -173,9 +173,14 @@ class FuzzySystem:
             shape = clipped.sum(axis=1) if self.aggregation == "sum" else clipped.max(axis=1)
             area = shape.sum(axis=1)
             grid = self._grid[o]
+            # The centroid's numerator is a per-row numpy sum, not ``shape @ grid``: BLAS (OpenBLAS dgemv) sums a
+            # row in an order that depends on the row's position in the batch, so identical inputs came out
+            # 1 ulp apart (0.38743243243243236 vs ...24 for the last of 9 rows), and the devolution broke exact
+            # ties by that noise instead of by file order (Fig 7.16's one-explorer choices under W7).
+            numerator = (shape * grid).sum(axis=1)
             with np.errstate(invalid="ignore", divide="ignore"):
                 # MATLAB returns the middle of the range when no rule fires.
-                out[:, o] = np.where(area > 0, shape @ grid / area, 0.5 * (variable.lo + variable.hi))
+                out[:, o] = np.where(area > 0, numerator / area, 0.5 * (variable.lo + variable.hi))
         return out
 
     def trace(self, x, **params) -> Trace:

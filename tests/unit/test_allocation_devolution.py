@@ -9,7 +9,7 @@ import pytest
 
 from teamsim.bench_allocate import random_problem
 from teamsim.controllers.allocation_spec import RobotSpec, TaskSpec, load_robots, load_tasks
-from teamsim.controllers.devolution import allocate
+from teamsim.controllers.devolution import TIE_TOLERANCE, allocate, rank
 
 
 @pytest.fixture(scope="module")
@@ -23,6 +23,18 @@ def robot(name, proc=(6, 4, "mc"), comm=(11, 100), ir=10, act=(1.25, 0.4, 0.5, 0
 
 def task(name, role, proc, grades, **kw) -> TaskSpec:
     return TaskSpec(name, role, name, "continuous", proc, grades, "any", kw.pop("vsw", (0.25,) * 4), **kw)
+
+
+def test_rank_breaks_ties_within_tolerance_by_file_order():
+    # robots are file indices; 0.5 and 0.5 + 1e-16 (round-off) tie, so index 1 goes before index 3
+    assert rank([3, 1, 2], [0.5 + 1e-16, 0.5, 0.7]) == [2, 1, 3]
+    assert rank([3, 1], [0.5 + 1e-16, 0.5], tolerance=0.0) == [3, 1]  # bit-exact comparison would not tie them
+    # a real difference keeps value order, however small against the values themselves
+    assert rank([1, 2], [0.5, 0.5 + 100 * TIE_TOLERANCE]) == [2, 1]
+    # a group is measured from its best value: 0.5 + 0.6 tol ties with 0.5 + 1.2 tol; 0.5, 1.2 tol below, does not
+    tol = TIE_TOLERANCE
+    assert rank([4, 3, 2, 1], [0.5 + 1.2 * tol, 0.5 + 0.6 * tol, 0.5, 0.1]) == [3, 4, 2, 1]
+    assert rank([], []) == []
 
 
 def test_managers_table_5_27(thesis):
