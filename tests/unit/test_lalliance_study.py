@@ -51,9 +51,13 @@ def test_optimal_time_is_the_best_assignment():
 
 def test_optimal_triples_and_regions():
     triples = optimal_triples()
-    assert len(triples) == 502 and len(optimal_triples(inclusive=True)) == 503
+    assert len(triples) == 496  # §4.5.4's count
     counts = [sum(region_of(c, m) == region for _, m, c in triples) for region in (1, 2, 3, 4)]
-    assert counts == [332, 143, 27, 0]  # the thesis: 331, 139, 26 and none in region 4
+    assert counts == [331, 139, 26, 0]  # the thesis's, and none in region 4
+    # the bounds the thesis states add the six (7, 6, c) triples (7^6 = 117 649), and (2, 17, 2) for n^m <= 2^17
+    footnote, text = optimal_triples("footnote"), optimal_triples("text")
+    assert sorted(set(footnote) - set(triples)) == [(7, 6, c) for c in range(2, 8)] and set(triples) <= set(footnote)
+    assert set(text) - set(footnote) == {(2, 17, 2)}
     assert (4, 8, 3) in triples and region_of(3, 8) == 3 and (5, 6, 5) in triples and region_of(5, 6) == 2
     assert [region_of(c, 10) for c in (11, 10, 4, 3, 1, 0.5)] == [1, 2, 2, 3, 3, 4]
     assert [heterogeneity_class(x) for x in (0, 200, 400, 800)] == ["none", "mild", "between", "high"]
@@ -143,4 +147,6 @@ def test_study_writes_csv_and_report_and_is_deterministic(tmp_path):
                     "Claim 12", "Disagreements"):
         assert heading in report
     assert "different results on 0 of" in report
-    assert "teamsim counts 502" in report.split("## Disagreements")[1]  # the triple count is flagged
+    assert "teamsim counts" not in report  # the triple count is the thesis's: not flagged
+    assert "| 12: triples | 496 triples, 331/139/26 in regions 1/2/3 | 496 triples, 331/139/26 in regions 1/2/3 | " \
+           "reproduced |" in report
