@@ -372,7 +372,7 @@ class MoveSpill(SetController):
         """"Wander in a straight line" through the spill area (Fig. 3-7 step 2): face a random point of it,
         then drive straight past it, scanning with the fingertip IR; avoid-obstacles is off."""
         p = self.params
-        if np.hypot(*(self.estimate.pose[:2] - self._search_centre())) > p.spill_vicinity + p.spill_radius:
+        if np.hypot(*(self.estimate.pose[:2] - self._search_centre())) > p.spill_vicinity + self._reach():
             self.state, self.line = "to_spill", None  # a failed pick-up can leave it far off
             return self._to_spill(obs)
         if self.line is None:
@@ -403,11 +403,17 @@ class MoveSpill(SetController):
         """(heading, length, None): through a random point near the search centre, and ``sweep_overshoot``
         beyond it. The area widens by ``spill_radius`` every ``widen_every`` lines that find nothing."""
         p = self.params
-        reach = p.spill_radius * (1.0 + self.empty_lines / p.widen_every)  # pucks get pushed about: widen the search
-        radius, bearing = reach * math.sqrt(self.rng.random()), self.rng.uniform(-math.pi, math.pi)
+        radius, bearing = self._reach() * math.sqrt(self.rng.random()), self.rng.uniform(-math.pi, math.pi)
         point = np.asarray(self._search_centre()) + radius * np.array([math.cos(bearing), math.sin(bearing)])
         dx, dy = point - self.estimate.pose[:2]
         return math.atan2(dy, dx), math.hypot(dx, dy) + p.sweep_overshoot, None
+
+    def _reach(self) -> float:
+        """Radius of the search area: pucks get pushed about, so it widens as lines find nothing. (The robot may
+        sweep out to it: with the area's first radius as the limit, lines towards a widened edge were cut short
+        and pucks pushed 2-3 m off the spill were never found.)"""
+        p = self.params
+        return p.spill_radius * (1.0 + self.empty_lines / p.widen_every)
 
     def _begin(self, state: str, behaviours: list, obs: Observation) -> Command:
         self.state, self.step = state, G.Sequence(behaviours)
