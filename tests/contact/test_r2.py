@@ -254,6 +254,20 @@ def test_approach_centres_an_offset_puck_between_the_pads(dy, yaw):
     assert abs(puck[1]) < R2.half_jaw - PUCK.radius
 
 
+def test_lifts_its_rated_payload_of_0_91_kg():
+    """Parker §2.2.1: the R-2's gripper lifts 2 lb (0.91 kg); the lift is sized 1.3x that plus the carriage."""
+    layout = sensors()
+    sequence = G.Sequence([G.Approach(layout), G.Grasp(layout), G.Lift(layout)])
+    world, red = solo(sequence, pucks=[(PUCK_X, 0.0)], puck_dims=PuckDims(mass=0.91))
+    resting = body_pose(world, "puck0/puck")[2]
+    run_for(world, 20.0, until=lambda w: sequence.status != G.RUNNING)
+    assert sequence.status == G.SUCCEEDED
+    run_for(world, 2.0)  # held up, not sliding out of the pads
+    rise = body_pose(world, "puck0/puck")[2] - resting
+    assert rise > 0.1, f"the 0.91 kg puck rose {rise:.3f} m"
+    assert unstable_warnings(world) == []
+
+
 def test_cannot_lift_two_kilograms():
     layout = sensors()
     sequence = G.Sequence([G.Approach(layout), G.Grasp(layout), G.Lift(layout)])
