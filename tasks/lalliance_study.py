@@ -34,8 +34,6 @@ this module). Boundaries of the regions (p.95 gives open intervals): coverage/m 
 from __future__ import annotations
 
 import concurrent.futures as futures
-import csv
-import io
 import math
 import multiprocessing
 import time
@@ -45,7 +43,7 @@ from pathlib import Path
 
 import numpy as np
 
-from teamsim.recording import write_atomic
+from teamsim.recording import write_atomic, write_csv
 from teamsim.rng import RandomStreams
 from teamsim.tasks.abstract_allocation import (TeamSettings, draw_problem, optimal_energy, optimal_time,
                                                run_team)
@@ -255,19 +253,9 @@ def run_study(out_dir: str | Path, workers: int, full: bool = False, runs: int |
     rows = study_rows(study, seed, workers)
     wall = time.perf_counter() - start
     csv_path, report_path = out / "results.csv", out / "report.md"
-    write_atomic(csv_path, rows_to_csv(rows).encode())
+    write_csv(csv_path, COLUMNS, rows, float_format=".6f")
     write_atomic(report_path, report(rows, study, seed, wall, workers).encode())
     return {"results": csv_path, "report": report_path, "rows": len(rows), "wall_s": wall}
-
-
-def rows_to_csv(rows: list[dict]) -> str:
-    buffer = io.StringIO()
-    writer = csv.DictWriter(buffer, fieldnames=COLUMNS, lineterminator="\n")
-    writer.writeheader()
-    for row in rows:
-        writer.writerow({k: ("" if isinstance(v, float) and math.isnan(v) else
-                             (f"{v:.6f}" if isinstance(v, float) else v)) for k, v in row.items()})
-    return buffer.getvalue()
 
 
 # ---------------------------------------------------------------- the report

@@ -27,8 +27,6 @@ and 5, three worlds per cell); ``full`` runs §4.6's whole grid, which takes hou
 """
 from __future__ import annotations
 
-import csv
-import io
 import math
 import time
 from collections import defaultdict
@@ -41,7 +39,7 @@ from teamsim.controllers.astar import modified_astar
 from teamsim.controllers.two_tier_astar import (TwoTierParams, local_map_node_budget, partition_global_map,
                                                 transmission_time, two_tier_astar)
 from teamsim.plots import grouped_bars
-from teamsim.recording import write_atomic
+from teamsim.recording import write_atomic, write_csv
 from teamsim.rng import RandomStreams
 from teamsim.stats import paired_t_test
 from teamsim.sweep import run_trials
@@ -233,18 +231,9 @@ def run_study(study: TwoTierStudy, out: Path, workers: int = 1) -> dict:
     rows = [row for result in results for row in result.get("rows", [])]
     failed = [f"{world_label(j.nodes)} {j.density:.0%} world {j.trial}: {r.get('error')}"
               for j, r in zip(world_jobs, results) if "rows" not in r]
-    write_atomic(out / "results.csv", rows_to_csv(rows).encode())
+    write_csv(out / "results.csv", COLUMNS, rows, float_format=".6g")
     write_atomic(out / "report.md", report(study, rows, failed, wall, workers, out).encode())
     return {"report": out / "report.md", "results": out / "results.csv", "rows": len(rows), "wall_s": wall}
-
-
-def rows_to_csv(rows: list[dict]) -> str:
-    buffer = io.StringIO()
-    writer = csv.DictWriter(buffer, fieldnames=COLUMNS, lineterminator="\n")
-    writer.writeheader()
-    for row in rows:
-        writer.writerow({k: (f"{v:.6g}" if isinstance(v, float) else v) for k, v in row.items()})
-    return buffer.getvalue()
 
 
 # ====================================================================== analysis and report

@@ -64,12 +64,17 @@ def write_atomic(path: Path, data: bytes) -> None:
     os.replace(tmp, path)
 
 
-def write_csv(path: Path, columns: Sequence[str], rows: Iterable[dict]) -> None:
-    """A study's results table, one row per trial, written atomically."""
+def write_csv(path: Path, columns: Sequence[str], rows: Iterable[dict], float_format: str | None = None) -> None:
+    """A study's results table, one row per trial, written atomically. With ``float_format`` (e.g. ".6g"), floats
+    are written in it and NaN as an empty cell."""
     buffer = io.StringIO()
-    writer = csv.DictWriter(buffer, fieldnames=list(columns))
+    writer = csv.DictWriter(buffer, fieldnames=list(columns), lineterminator="\n")
     writer.writeheader()
-    writer.writerows(rows)
+    for row in rows:
+        if float_format is not None:
+            row = {k: ("" if math.isnan(v) else format(v, float_format)) if isinstance(v, float) else v
+                   for k, v in row.items()}
+        writer.writerow(row)
     write_atomic(path, buffer.getvalue().encode())
 
 
