@@ -9,7 +9,12 @@ too.
 
 Dynamic window: the wall time of each controller call (direction sensor, dynamic window, obstacle memory: one
 control tick of one robot) of FRC driving Chand's Robot A (tricycle) and Robot B (differential) across random
-worlds without physics (``teamsim.tasks.nav_worlds.kinematic_run``). Target: 2 ms a call.
+worlds without physics (``teamsim.tasks.nav_worlds.kinematic_run``). Target: 2 ms a call. The inputs of every
+dynamic-window decision of those runs are recorded and replayed, call by call in turn, through a fresh
+``DynamicWindow.decide`` (numpy over all candidates at once) and the plain ``reference_decide``
+(``teamsim.controllers.reference_dwa``: Python loops over the candidates and the obstacle points), which evaluates
+the same window, candidates and objectives and must choose the same (v, omega): the ratio of their mean times is
+the implementation's alone. It covers the dynamic-window stage, not the direction sensor or obstacle memory.
 """
 from __future__ import annotations
 
@@ -19,7 +24,8 @@ import time
 import numpy as np
 
 from teamsim.controllers.astar import PlannerParams, astar, cost_maps, reference_astar
-from teamsim.controllers.dynamic_window import FRC
+from teamsim.controllers.dynamic_window import FRC, DynamicWindow
+from teamsim.controllers.reference_dwa import reference_decide
 from teamsim.models.robot import DriveLimits
 from teamsim.tasks.nav_worlds import KinematicRobot, kinematic_run, random_world
 
@@ -61,18 +67,50 @@ def time_astar(size: int, density: float, seed: int) -> dict:
             "thesis_expanded": thesis.expanded}
 
 
+def record_decisions(controller: FRC, record: list) -> None:
+    """Make ``controller`` append the arguments of each of its dynamic-window decisions to ``record``."""
+    decide = controller.window.decide
+
+    def recorded(*args, **kwargs):
+        record.append((args, kwargs))
+        return decide(*args, **kwargs)
+
+    controller.window.decide = recorded
+
+
 def time_decisions(density: float, worlds: int, duration: float) -> dict:
     rows = {}
     for name, robot in ROBOTS.items():
-        times = []
+        times, inputs = [], []
         for seed in range(worlds):
             world = random_world(density, np.random.default_rng(seed))
             controller = FRC(robot.limits, robot.kind, robot.radius, world.goal, centre_offset=robot.centre_offset)
+            record_decisions(controller, inputs)
             times.append(kinematic_run(world, controller, robot, duration).decision_times)
         times = np.concatenate(times)
         rows[name] = {"calls": int(times.size), "mean_ms": 1e3 * float(times.mean()),
-                      "median_ms": 1e3 * float(np.median(times)), "p99_ms": 1e3 * float(np.percentile(times, 99))}
+                      "median_ms": 1e3 * float(np.median(times)), "p99_ms": 1e3 * float(np.percentile(times, 99)),
+                      "replay": replay_decisions(robot, inputs)}
     return rows
+
+
+def replay_decisions(robot: KinematicRobot, inputs: list) -> dict:
+    """Each recorded decision through a fresh ``DynamicWindow.decide`` and through ``reference_decide``, timed call
+    by call in turn; whether they chose the same (v, omega) (within 1e-9) and branch."""
+    window = DynamicWindow(robot.limits, robot.kind, robot.radius, centre_offset=robot.centre_offset)
+    frc_times, reference_times, same, branches = [], [], 0, {}
+    for args, kwargs in inputs:
+        began = time.perf_counter()
+        decision = window.decide(*args, **kwargs)
+        middle = time.perf_counter()
+        v, omega, branch, _ = reference_decide(window, *args, **kwargs)
+        reference_times.append(time.perf_counter() - middle)
+        frc_times.append(middle - began)
+        same += abs(v - decision.v) <= 1e-9 and abs(omega - decision.omega) <= 1e-9 and branch == decision.branch
+        branches[decision.branch] = branches.get(decision.branch, 0) + 1
+    frc_ms, reference_ms = 1e3 * float(np.mean(frc_times)), 1e3 * float(np.mean(reference_times))
+    return {"decisions": len(inputs), "frc_mean_ms": frc_ms, "reference_mean_ms": reference_ms,
+            "ratio": reference_ms / frc_ms, "same": same, "branches": branches}
 
 
 def run(grid_size: int = 1000, grid_density: float = 0.2, seed: int = 0, world_density: float = 0.10,
@@ -94,6 +132,14 @@ def run(grid_size: int = 1000, grid_density: float = 0.2, seed: int = 0, world_d
         verdict = "ok" if row["mean_ms"] <= DECISION_TARGET * 1e3 else "OVER TARGET"
         print(f"  {name:<17} mean {row['mean_ms']:5.2f} ms  median {row['median_ms']:5.2f} ms  "
               f"p99 {row['p99_ms']:5.2f} ms  over {row['calls']} calls  {verdict}")
+    print("bench nav: the dynamic window's decision alone, FRC (DynamicWindow.decide) against the plain "
+          "reference_decide on the same recorded inputs")
+    for name, row in decisions.items():
+        r = row["replay"]
+        branches = ", ".join(f"{branch} {count}" for branch, count in sorted(r["branches"].items()))
+        print(f"  {name:<17} FRC mean {r['frc_mean_ms']:5.2f} ms  reference mean {r['reference_mean_ms']:5.2f} ms  "
+              f"ratio reference / FRC {r['ratio']:4.1f}x  same command {r['same']}/{r['decisions']}  "
+              f"({branches})")
     return {"astar": a, "decisions": decisions}
 
 
