@@ -18,9 +18,9 @@ from teamsim.runner import run_trial
 from teamsim.tasks.hazardous_waste import HazardousWasteParams
 
 
-def cleanup(tmp_path, seed: int, *faults: str):
+def cleanup(tmp_path, seed: int, *faults: str, duration: float | None = None):
     config = TrialConfig(mission="hazardous-waste", params=HazardousWasteParams(), seed=seed, out=str(tmp_path),
-                         run_id="run", faults=[parse_fault(f) for f in faults])
+                         run_id="run", faults=[parse_fault(f) for f in faults], duration=duration)
     result = run_trial(config, progress=False)
     return result.summary, tmp_path / "hazardous-waste" / "run"
 
@@ -49,13 +49,27 @@ def test_three_robots_clean_up_with_red_finding_the_locations(tmp_path):
 
 
 def test_a_teammate_takes_over_the_search_when_red_dies(tmp_path):
-    summary, _ = cleanup(tmp_path, 4, "kill:red@40")
+    """Red dies by the north wall at 40 s, mid-search; blue or green takes the search over with find-wander,
+    finds the locations round red's body and tells the team: every living robot believes a goal inside the goal
+    zone and a spill within 0.5 m of the spill's centre. (Whether the two then finish the cleanup is the study's
+    business: `teamsim study cleanup-faults`, 6 of 10 at the last count, docs/hazardous-waste.md.)"""
+    summary, _ = cleanup(tmp_path, 4, "kill:red@40", duration=400.0)
     metrics = summary["metrics"]
-    assert summary["status"] == "completed", summary.get("error")
+    assert summary["status"] in ("completed", "failed"), summary.get("error")
     assert not summary["robots"]["red"]["alive"]
     wanderers = [n for n in ("blue", "green") if summary["robots"][n]["task_time_s"].get("find-locations-wander")]
     assert wanderers, metrics
+    task = summary["scenario"]["task"]
+    spill = np.mean([[p["x"], p["y"]] for p in summary["scenario"]["objects"]["pucks"]], axis=0)
+    for name in ("blue", "green"):
+        belief = metrics["per_robot"][name]
+        assert belief["located"], name
+        gx, gy = belief["goal"]
+        assert abs(gx - task["goal"][0]) <= task["goal_size"][0] / 2 and abs(gy - task["goal"][1]) <= \
+            task["goal_size"][1] / 2, (name, belief["goal"])
+        assert np.hypot(*(np.array(belief["spill"]) - spill)) < 0.5, (name, belief["spill"], spill)
     assert metrics["per_robot"]["red"]["transports"] == 0
+    assert metrics["transports"] >= 1  # and the survivors are moving the spill
 
 
 def test_without_radio_every_robot_finds_and_reports_for_itself(tmp_path):
