@@ -35,7 +35,7 @@ def run_trials(configs: Iterable[TrialConfig], workers: int | None = None, backe
         return _run_on_ray(configs, run)
     if backend != "process":
         raise ValueError(f"backend {backend!r}: allowed: process, ray")
-    bar = Progress(len(configs), f"{len(configs)} trials on {workers} workers")
+    bar = Progress(len(configs), f"{len(configs)} trials on {workers} workers", unit="trials done")
     results: list[dict | None] = [None] * len(configs)
     if workers == 1:
         for k, config in enumerate(configs):

@@ -45,3 +45,17 @@ def test_progress_draws_only_when_enabled():
     assert quiet.getvalue() == ""
     assert "wander [###############" in loud.getvalue() and "5.0/10.0 s sim" in loud.getvalue()
     assert "x real time" in loud.getvalue()
+
+
+def test_logged_progress_is_a_line_now_and_then():
+    log = io.StringIO()
+    bar = Progress(720, "720 trials on 2 workers", stream=log, unit="trials done", log_every=0.0)
+    bar.update(3)
+    bar.update(10)
+    bar.finish()
+    lines = log.getvalue().splitlines()
+    assert len(lines) == 2 and lines[0].startswith("720 trials on 2 workers: 3/720 trials done")
+    assert "\r" not in log.getvalue() and "real time" not in log.getvalue()
+    hourly = io.StringIO()
+    Progress(10.0, "wander", stream=hourly, log_every=3600.0).update(5.0)
+    assert hourly.getvalue() == ""  # runs shorter than log_every stay quiet
