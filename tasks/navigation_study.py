@@ -153,8 +153,7 @@ def compare(cells: dict, robot: str, density: float, controller: str) -> dict:
 
 def run_study(study: NavigationStudy) -> Path:
     configs = trial_configs(study)
-    run = BACKENDS[study.backend]
-    summaries = run_trials(configs, workers=study.workers, **({"run": run} if run else {}))
+    summaries = run_trials(configs, workers=study.workers, run=BACKENDS[study.backend])
     rows = [result_row(c, s) for c, s in zip(configs, summaries)]
     study.out.mkdir(parents=True, exist_ok=True)
     write_results(study.out / "results.csv", rows)

@@ -37,11 +37,9 @@ class Progress:
 
     def _figures(self, done: float, now: float) -> str:
         elapsed = max(now - self.start, 1e-9)
-        text = f"{done:7.1f}/{self.total:.1f} {self.unit}" if self.unit == SIMULATED else \
-            f"{done:g}/{self.total:g} {self.unit}"
         if self.unit == SIMULATED:
-            return f"{text}  {done / elapsed:6.1f}x real time"
-        return f"{text}  {elapsed:.0f} s elapsed"
+            return f"{done:7.1f}/{self.total:.1f} {self.unit}  {done / elapsed:6.1f}x real time"
+        return f"{done:g}/{self.total:g} {self.unit}  {elapsed:.0f} s elapsed"
 
     def finish(self) -> None:
         if self.mode == "bar":

@@ -27,8 +27,10 @@ def default_workers() -> int:
 
 
 def run_trials(configs: Iterable[TrialConfig], workers: int | None = None, backend: str = "process",
-               run: Callable[[TrialConfig], dict] = _run_one) -> list[dict]:
-    """Summaries of ``run(config)`` for every configuration, in order. ``backend`` is "process" or "ray"."""
+               run: Callable[[TrialConfig], dict] | None = None) -> list[dict]:
+    """Summaries of ``run(config)`` (default: ``run_trial``'s) for every configuration, in order. ``backend`` is
+    "process" or "ray"."""
+    run = run or _run_one
     configs = list(configs)
     workers = workers or default_workers()
     if backend == "ray":
