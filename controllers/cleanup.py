@@ -38,7 +38,7 @@ from teamsim.controllers import gripper as G
 from teamsim.controllers.alliance import (AllianceController, AllianceParams, AllianceRobot, BehaviourSetDefinition,
                                           MotivationRates)
 from teamsim.controllers.base import Command, Observation
-from teamsim.controllers.goto import AvoidObstacles, DriveParams, steer_to, turn_to
+from teamsim.controllers.goto import AvoidObstacles, DriveParams, Unstick, steer_to, turn_to
 from teamsim.controllers.lalliance import TaskStatistics
 from teamsim.controllers.learned_acquiescence import LearnedAcquiescence, LearningParams
 from teamsim.controllers.pose_estimate import PoseEstimate
@@ -78,7 +78,9 @@ class CleanupParams:
     sweep_speed: float = 0.2  # m/s while scanning: 2 cm per control period
     widen_every: int = 4  # empty sweep lines
     hint_lines: int = 4  # empty sweep lines around where it last had a puck before it searches the spill again
-    empty_lines: int = 16  # consecutive sweep lines without a puck: the spill is gone
+    # consecutive sweep lines without a puck: the spill is gone. By the 32nd the area has widened to 5.4 m, the whole
+    # room: with 16 (3 m) a team stopped with 5 pucks at the goal and one 0.5 m from the spill (kill-red seed 5)
+    empty_lines: int = 32
     goal_spread: float = 0.25  # m: deliveries land this far either side of the believed goal
     goal_keepout: float = 1.5  # m: pucks this near the believed goal are never searched for (they are moved)
     goal_clearance: float = 0.45  # m: the drop point stands this far in from the goal-side extent
@@ -531,6 +533,7 @@ class CleanupRobot:
         core = AllianceRobot(robot.name, [d.behaviour_set for d in definitions], alliance)
         self.learning = LearnedAcquiescence(core, (MOVE,), params.learning, learned)
         self.alliance = AllianceController(robot.name, definitions, alliance, selector=self.learning)
+        self.unstick = Unstick(rng, params.drive, escape_extras={"lift": G.UP})
         self.active = "idle"
 
     def __call__(self, obs: Observation) -> Command:
@@ -543,7 +546,7 @@ class CleanupRobot:
         if k.home is None:
             k.home = pose[:2].copy()
         delivered_last_tick = k.just_delivered
-        command = self.alliance(obs)
+        command = self.unstick(obs, self.alliance(obs))
         if delivered_last_tick:  # move-spill's feedback has been down for one tick: it is done with that load
             k.just_delivered = False
         if command.behaviour != self.active:

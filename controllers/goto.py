@@ -5,6 +5,11 @@ an IR sensor sees something closer than ``avoid_range``, it takes over for a sho
 it, then turn away from the side that sensed it: right when it was dead ahead, a random side when behind), then hands control back. Parker's
 move-spill suppresses it while picking up, so that the robot can drive its jaw around a puck.
 
+:class:`Unstick` lies under it: a robot asked to move that the positioning service shows going nowhere raises
+its lift and backs off. Parker's R-2s lowered their jaw onto pucks they could not sense under the fingers and
+lifted their own wheels off the floor (§3.8.4, "needed manual rescue"); ours do the same at the goal, where the
+delivered pucks lie, and must get out unaided.
+
 :func:`steer_to` is the go-to-point behaviour: turn towards the target on the spot when it is far off the
 heading, else drive at it with a proportional turn, slowing down near it. The thesis gives the behaviours'
 names, not their control laws, so the laws and every constant in :class:`DriveParams` are assumed.
@@ -12,11 +17,12 @@ names, not their control laws, so the laws and every constant in :class:`DrivePa
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from collections import deque
+from dataclasses import dataclass, replace
 
 import numpy as np
 
-from teamsim.controllers.base import Observation
+from teamsim.controllers.base import Command, Observation
 from teamsim.positioning import wrap_angle
 
 
@@ -32,6 +38,16 @@ class DriveParams:
     back_time: float = 0.8  # s of backing off
     back_speed: float = 0.15  # m/s
     turn_time: float = 1.0  # s of turning away afterwards
+    # Unstick (see :class:`Unstick`): asked to move (at least stuck_speed or stuck_turn_rate) for stuck_window s
+    # while every positioning fix of that time lies within stuck_moved of their mean and stuck_turned of their
+    # heading, the robot is stuck. Still fixes scatter by 1.3 cm and 0.05 rad (positioning): 8 of them stay
+    # within 5 cm and 0.25 rad; a robot that drives or turns leaves that in a second.
+    stuck_speed: float = 0.1  # m/s (the gripper's approach creeps slower: pick-ups never count)
+    stuck_turn_rate: float = 0.5  # rad/s
+    stuck_window: float = 5.0  # s
+    stuck_moved: float = 0.05  # m
+    stuck_turned: float = 0.25  # rad
+    unstick_back_time: float = 2.0  # s of backing off with the lift up, then turn_time of turning
 
 
 def steer_to(pose: np.ndarray, target, params: DriveParams, arrive: float) -> tuple[float, float] | None:
@@ -103,3 +119,53 @@ class AvoidObstacles:
 
 
 _BUMPER_BEARING = {"front": 0.0, "left": math.pi / 2, "right": -math.pi / 2, "back": math.pi}
+
+
+class Unstick:
+    """Get out of places the wheels cannot: the jaw pressed onto a puck (wheels lifted), wedged against a wall or
+    a robot with avoid-obstacles off. ``__call__(obs, command)`` passes the command through, or, once the robot
+    has been asked to move for ``stuck_window`` s while its positioning fixes stood still (:class:`DriveParams`),
+    replaces it with an escape: back off for ``unstick_back_time``, then turn to a random side for ``turn_time``,
+    with ``escape_extras`` overriding the command's extras meanwhile (an R-2 raises its lift, freeing the wheels;
+    its grip is left as commanded, so a held load stays held). ``escapes`` counts them."""
+
+    def __init__(self, rng: np.random.Generator, params: DriveParams = DriveParams(), escape_extras: dict | None = None):
+        self.rng = rng
+        self.params = params
+        self.escape_extras = dict(escape_extras or {})
+        self.fixes: deque = deque()  # (time, x, y, heading) of the fixes since the robot was last asked to stop
+        self.back_until = self.until = -math.inf
+        self.turn = 0.0
+        self.escapes = 0
+
+    def __call__(self, obs: Observation, command: Command) -> Command:
+        p = self.params
+        if obs.time < self.until:
+            v, omega = (-p.back_speed, 0.0) if obs.time < self.back_until else (0.0, self.turn)
+            return replace(command, v=v, omega=omega, extras={**command.extras, **self.escape_extras})
+        if abs(command.v) < p.stuck_speed and abs(command.omega) < p.stuck_turn_rate:
+            self.fixes.clear()
+            return command
+        fix = obs.pose
+        if fix is not None and (not self.fixes or fix.time > self.fixes[-1][0]):
+            self.fixes.append((fix.time, fix.x, fix.y, fix.heading))
+        if self._stuck(obs.time):
+            self.fixes.clear()
+            self.escapes += 1
+            self.back_until = obs.time + p.unstick_back_time
+            self.until = self.back_until + p.turn_time
+            self.turn = self.rng.choice((-1.0, 1.0)) * p.turn_rate
+            return self(obs, command)
+        return command
+
+    def _stuck(self, now: float) -> bool:
+        p = self.params
+        if not self.fixes or now - self.fixes[0][0] < p.stuck_window:
+            return False
+        while len(self.fixes) > 1 and now - self.fixes[1][0] >= p.stuck_window:  # keep one fix at least stuck_window old
+            self.fixes.popleft()
+        _, x, y, heading = np.array(self.fixes).T
+        spread = np.hypot(x - x.mean(), y - y.mean()).max()
+        mean_heading = math.atan2(np.sin(heading).mean(), np.cos(heading).mean())
+        turned = max(abs(wrap_angle(h - mean_heading)) for h in heading)
+        return spread < p.stuck_moved and turned < p.stuck_turned

@@ -53,6 +53,9 @@ class GripperParams:
     lower_timeout: float = 6.0  # s
     back_off_speed: float = 0.05  # m/s while backing away from a released object
     release_timeout: float = 6.0  # s
+    # s a hold must stay gone before a raised object counts as lost: the pad force reading dips for single ticks
+    # as the pads settle on a swinging puck (measured 30 -> 2 N for one tick mid-turn, the puck still held)
+    lost_time: float = 0.25
 
 
 @dataclass(frozen=True)
@@ -93,6 +96,7 @@ class Behaviour:
         self.status = RUNNING
         self.started: float | None = None
         self.reason = ""  # why it failed
+        self.unheld_since: float | None = None
 
     def __call__(self, obs: Observation) -> Command:
         if self.started is None:
@@ -106,6 +110,15 @@ class Behaviour:
 
     def command(self, v: float = 0.0, omega: float = 0.0) -> Command:
         return Command(v=v, omega=omega, behaviour=self.name, extras={"grip": self.grip, "lift": self.lift})
+
+    def lost(self, obs: Observation) -> bool:
+        """The held object has been gone for ``lost_time`` (see :class:`GripperParams`)."""
+        if self.sensors.holding(obs, self.params):
+            self.unheld_since = None
+            return False
+        if self.unheld_since is None:
+            self.unheld_since = obs.time
+        return obs.time - self.unheld_since >= self.params.lost_time
 
     def succeed(self) -> Command:
         self.status = SUCCEEDED
@@ -189,7 +202,7 @@ class Lift(Behaviour):
     def step(self, obs: Observation, elapsed: float) -> Command:
         p = self.params
         position = obs.effectors["lift"]
-        if not self.sensors.holding(obs, p):
+        if self.lost(obs):
             return self.fail("lost it")
         if position >= p.lift_done:
             return self.succeed()
@@ -211,7 +224,7 @@ class Carry(Behaviour):
         self.route = route
 
     def step(self, obs: Observation, elapsed: float) -> Command:
-        if not self.sensors.holding(obs, self.params):
+        if self.lost(obs):
             return self.fail("lost it")
         drive = self.route(obs)
         if drive is None:

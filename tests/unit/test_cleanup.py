@@ -9,7 +9,8 @@ import pytest
 
 from teamsim.controllers.base import Observation
 from teamsim.controllers.cleanup import CleanupKnowledge, locations_from_extents
-from teamsim.controllers.goto import AvoidObstacles, DriveParams, steer_to
+from teamsim.controllers.base import Command
+from teamsim.controllers.goto import AvoidObstacles, DriveParams, Unstick, steer_to
 from teamsim.controllers.pose_estimate import PoseEstimate
 from teamsim.models.robot import DifferentialSpec
 from teamsim.positioning import PoseFix
@@ -99,6 +100,57 @@ def test_avoid_backs_off_from_a_front_bump_then_turns_right_and_releases():
     v, omega = avoid(_observation(10.0, None, 0.0, ir=[np.inf, 0.1, np.inf, np.inf]))  # close on the left
     assert v > 0 and omega == 0.0  # not ahead: it moves on, then turns away to the right
     assert avoid(_observation(10.0 + p.back_time + 0.05, None, 0.0))[1] < 0
+
+
+def _fixes_while_asked(unstick, command, fix_at, seconds, rng, noise=0.0127, heading_noise=0.05):
+    """Run ``unstick`` at the control rate with a positioning fix every 0.6 s; the commands it returns."""
+    out = []
+    for k in range(round(seconds / 0.1)):
+        t = 0.1 * k
+        x, y, heading = fix_at(0.6 * math.floor(t / 0.6))
+        fix = PoseFix(x + rng.normal(0, noise), y + rng.normal(0, noise), heading + rng.normal(0, heading_noise),
+                      0.6 * math.floor(t / 0.6))
+        out.append(unstick(_observation(t, fix, 0.0), command))
+    return out
+
+
+def test_unstick_backs_off_with_the_lift_up_when_asked_to_move_but_the_fixes_stand_still():
+    """The wheels lifted by the jaw on a puck (§3.8.4): asked to turn, the robot's fixes do not move."""
+    p = DriveParams()
+    unstick = Unstick(np.random.default_rng(1), p, escape_extras={"lift": 1.0})
+    turn = Command(omega=p.turn_rate, behaviour="move-spill", extras={"grip": 0.0, "lift": 0.0})
+    out = _fixes_while_asked(unstick, turn, lambda t: (3.1, 0.2, 0.5), p.stuck_window + 0.6 + 3.0,
+                             np.random.default_rng(2))
+    escaping = [k for k, c in enumerate(out) if c.v < 0]
+    assert unstick.escapes == 1 and escaping
+    assert p.stuck_window <= 0.1 * escaping[0] <= p.stuck_window + 0.7  # within a fix of the window
+    first = out[escaping[0]]
+    assert first.omega == 0.0 and first.extras == {"grip": 0.0, "lift": 1.0}  # lift up, the grip untouched
+    assert first.behaviour == "move-spill"
+    after = out[escaping[0] + round(p.unstick_back_time / 0.1) + 1]
+    assert after.v == 0.0 and abs(after.omega) == p.turn_rate
+
+
+@pytest.mark.parametrize("motion", ["drive", "turn"])
+def test_unstick_leaves_a_robot_that_moves_alone(motion):
+    """Driving at 0.3 m/s with 0.15 m fix noise, or turning on the spot at 1 rad/s: never stuck."""
+    p = DriveParams()
+    unstick = Unstick(np.random.default_rng(1), p)
+    if motion == "drive":
+        command, noise, fix_at = Command(v=0.3), 0.15, lambda t: (0.3 * t, 0.0, 0.0)
+    else:
+        command, noise, fix_at = Command(omega=1.0), 0.0127, lambda t: (0.0, 0.0, math.remainder(t, 2 * math.pi))
+    out = _fixes_while_asked(unstick, command, fix_at, 60.0, np.random.default_rng(3), noise)
+    assert unstick.escapes == 0 and all(c is command for c in out)
+
+
+def test_unstick_ignores_standing_still_when_not_asked_to_move():
+    """Grasping, lifting, creeping up on a puck at 6 cm/s: the robot stands (nearly) still on purpose."""
+    p = DriveParams()
+    for command in (Command(), Command(v=0.06, omega=0.3)):
+        unstick = Unstick(np.random.default_rng(1), p)
+        out = _fixes_while_asked(unstick, command, lambda t: (1.0, 1.0, 0.0), 30.0, np.random.default_rng(4))
+        assert unstick.escapes == 0 and all(c is command for c in out)
 
 
 class _Pose:
