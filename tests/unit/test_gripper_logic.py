@@ -118,13 +118,20 @@ def test_lift_stalls_under_too_heavy_a_load():
     assert t == pytest.approx(P.stall_time + 0.1, abs=0.15)
 
 
-def test_lift_and_carry_fail_when_the_object_is_lost():
+def test_lift_and_carry_fail_when_the_object_is_lost_for_lost_time():
+    lost_time = G.GripperParams().lost_time
     lift = G.Lift(LAYOUT)
     lift(obs(grip=0.67, lift=0.3, force=30.0))
+    assert lift.status == G.RUNNING, "one tick with the beams clear is not yet a loss"
+    lift(obs(t=lost_time, grip=0.67, lift=0.3, force=30.0))
     assert (lift.status, lift.reason) == (G.FAILED, "lost it"), "beams clear"
     carry = G.Carry(LAYOUT, lambda o: (0.2, 0.0))
     carry(holding(0.0, 1.0))
     carry(obs(t=0.1, beams=(True, True), grip=0.67, lift=1.0, force=0.5))
+    carry(holding(0.2, 1.0))  # the force back a tick later: a dip, not a loss
+    carry(obs(t=0.3, beams=(True, True), grip=0.67, lift=1.0, force=0.5))
+    assert carry.status == G.RUNNING
+    carry(obs(t=0.3 + lost_time, beams=(True, True), grip=0.67, lift=1.0, force=0.5))
     assert (carry.status, carry.reason) == (G.FAILED, "lost it"), "no grip force"
 
 
