@@ -28,15 +28,18 @@ def test_spill_is_the_centre_of_the_front_third_and_goal_the_back_centre(home, s
     assert found["spill"] == pytest.approx(spill)
     assert found["goal"] == pytest.approx(goal)
     assert found["entrance"] == pytest.approx(entrance)
+    assert found["extents"] == tuple(EXTENTS)  # the room, as far as a robot's centre goes, for the search
 
 
 def test_a_robot_learns_locations_and_reports_from_teammates_broadcasts():
     k = CleanupKnowledge(report_interval=240.0)
     k.hear({"task": "idle", "report": 0.0, "spill_empty": False})
     assert not k.located
-    k.hear({"task": "find-locations", "spill": (1, 2), "goal": (3, 4), "entrance": (0, 0), "report": 0.0})
-    assert k.located and k.spill == (1, 2) and k.goal == (3, 4)
-    k.hear({"spill": (9, 9), "goal": (9, 9), "entrance": (9, 9)})  # first locations stick
+    k.hear({"task": "find-locations", "spill": (1, 2), "goal": (3, 4), "entrance": (0, 0),
+            "extents": (-1, 5, -2, 2), "report": 0.0})
+    assert k.located and k.spill == (1, 2) and k.goal == (3, 4) and k.extents == (-1, 5, -2, 2)
+    assert k.message()["extents"] == (-1, 5, -2, 2)  # passed on
+    k.hear({"spill": (9, 9), "goal": (9, 9), "entrance": (9, 9), "extents": (9, 9, 9, 9)})  # first locations stick
     assert k.goal == (3, 4)
     k.delivered()
     assert k.report_due(250.0)
@@ -229,3 +232,27 @@ def test_find_wander_without_obstacles_drives_the_leg_straight_to_the_wall():
     assert track[:, 0].max() > 3.4
     on_the_way = track[track[:, 0] < 3.3]
     assert np.abs(on_the_way[:, 1] - 1.41).max() < 1e-6  # no sidestep before the wall: nothing was in the way
+
+
+def test_sweep_lines_aim_inside_the_room_and_away_from_the_goal():
+    """Widened past the room's width (24 empty lines: 4.2 m), the search area is mostly beyond the walls; every
+    line's point is still drawn inside the extents the finder reached and out of the delivered pucks' way."""
+    from teamsim.controllers.cleanup import CleanupParams, MoveSpill
+    from teamsim.models import build_robot
+
+    params = CleanupParams()
+    found = locations_from_extents(np.array([-3.7, 3.7, -1.6, 1.6]), np.array([-3.2, 0.0]), params.goal_clearance)
+    knowledge = CleanupKnowledge(report_interval=240.0, home=np.array([-3.2, 0.0]))
+    knowledge.learn_locations(found)
+    estimate = _Pose(*found["spill"], 0.0)
+    spill = MoveSpill(build_robot("r2", "blue"), np.random.default_rng(5), knowledge, estimate, None, params)
+    spill.empty_lines = 24
+    points = []
+    for _ in range(300):
+        heading, length, _ = spill._new_line()
+        reach = length - params.sweep_overshoot
+        points.append(estimate.pose[:2] + reach * np.array([math.cos(heading), math.sin(heading)]))
+    points = np.array(points)
+    assert (np.abs(points[:, 0]) <= 3.7 + 1e-9).all() and (np.abs(points[:, 1]) <= 1.6 + 1e-9).all()
+    assert (np.hypot(*(points - np.array(found["goal"])).T) > params.goal_keepout).all()
+    assert np.hypot(*(points - np.array(found["spill"])).T).max() > 3.0  # and the search does reach down the room
