@@ -19,11 +19,12 @@ class PuckDims:
     height: float = 1.5 * INCH
     mass: float = 0.08
     friction: float = 0.8
-    # m: rolling friction (condim 6), a rolling-resistance coefficient of 0.04 at the puck's radius (hard plastic
-    # on a carpeted lab floor). Without it a puck knocked onto its side rolls on for ever: measured, five pucks
-    # rolled at about 3 mm/s from the goal to the far wall in one mission (kill-red seed 5). With it a puck
-    # rolling at 0.1 m/s stops within 7 cm.
-    rolling_friction: float = 0.001
+    # N m s per rad/s (and N s per m/s) on the puck's free joint: rolling resistance. MuJoCo's contacts as used
+    # here have none, and a puck knocked onto its side rolled on at about 3 mm/s for the rest of the mission
+    # (measured: five pucks from the goal to the far wall, kill-red seed 5). With this a puck rolling at 0.1 m/s
+    # stops within 6 cm, and a sliding or carried puck is unaffected (the force is 1e-4 of its friction). Rolling
+    # friction (condim 6) does the same but adds 4 constraint rows per puck contact, half as many again in all.
+    roll_damping: float = 1.5e-4
 
 
 @dataclass(frozen=True)
@@ -44,8 +45,8 @@ def puck(name: str, dims: PuckDims = PuckDims(), rgba=(0.95, 0.75, 0.1, 1)) -> m
     model = mjcf.RootElement(model=name)
     body = model.worldbody.add("body", name="puck")
     body.add("geom", name="shell", type="cylinder", size=[dims.radius, dims.height / 2],
-             pos=[0, 0, dims.height / 2], mass=dims.mass, rgba=rgba,
-             friction=[dims.friction, 0.005, dims.rolling_friction], condim=6)  # (against the floor MuJoCo takes the larger of each: the floor's sliding 1.0, this rolling)
+             pos=[0, 0, dims.height / 2], mass=dims.mass, rgba=rgba, friction=[dims.friction, 0.005, 0.0001],
+             condim=4)  # (against the floor, MuJoCo takes the larger friction: the floor's 1.0)
     return model
 
 
@@ -59,10 +60,13 @@ def box(name: str, dims: BoxDims = BoxDims(), rgba=(0.6, 0.45, 0.3, 1)) -> mjcf.
 
 
 def place(arena: mjcf.RootElement, thing: mjcf.RootElement, x: float, y: float, yaw: float = 0.0,
-          z: float = 0.0) -> mjcf.Element:
-    """Attach a free object into the arena at (x, y, z) with heading ``yaw``."""
+          z: float = 0.0, damping: float = 0.0) -> mjcf.Element:
+    """Attach a free object into the arena at (x, y, z) with heading ``yaw`` (and ``damping`` on its motion)."""
     frame = arena.attach(thing)
-    frame.add("freejoint")
+    if damping > 0:
+        frame.add("joint", type="free", damping=damping)
+    else:
+        frame.add("freejoint")
     frame.pos = [x, y, z]
     frame.euler = [0, 0, yaw]
     return frame

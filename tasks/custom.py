@@ -40,7 +40,7 @@ class CustomMission:
     def build(self, params: CustomParams, rng: np.random.Generator, newcomers, physics_dt: float) -> Scene:
         arena = walled_room(*params.room, obstacles=params.obstacles, physics_dt=physics_dt)
         for k, (x, y) in enumerate(params.pucks):
-            place(arena, puck(f"puck{k}", params.puck_dims), x, y)
+            place(arena, puck(f"puck{k}", params.puck_dims), x, y, damping=params.puck_dims.roll_damping)
         for k, (x, y, yaw) in enumerate(params.boxes):
             place(arena, box(f"box{k}", params.box_dims), x, y, yaw)
         for k, bog in enumerate(params.bogs):

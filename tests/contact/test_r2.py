@@ -327,6 +327,23 @@ def test_a_puck_under_the_raised_gripper_is_trapped_and_pushed():
     assert max(o.touch["bump_front"] for o in world.controllers["red"].observations) > 0.0, "the bumper feels it"
 
 
+def test_a_puck_knocked_onto_its_side_stops_rolling():
+    """Rolling resistance (PuckDims.roll_damping): on its side and rolling at 0.1 m/s, a puck stops within 8 cm
+    and stays; without it, it rolled on at constant speed (MuJoCo's contacts here have no rolling friction)."""
+    world, red = solo(lambda o: (0.0, 0.0), x=-2.0, pucks=[(0.5, 0.0)])
+    joint = world.model.body_jntadr[mujoco.mj_name2id(world.model, mujoco.mjtObj.mjOBJ_BODY, "puck0/")]  # the frame
+    adr, dof = world.model.jnt_qposadr[joint], world.model.jnt_dofadr[joint]
+    world.data.qpos[adr:adr + 3] = (0.5, 0.0, PUCK.radius)
+    world.data.qpos[adr + 3:adr + 7] = (math.cos(math.pi / 4), math.sin(math.pi / 4), 0.0, 0.0)  # axis along y
+    world.data.qvel[dof:dof + 6] = (0.1, 0.0, 0.0, 0.0, 0.1 / PUCK.radius, 0.0)  # rolling along +x
+    run_for(world, 3.0)
+    after_3s = body_pose(world, "puck0/puck")
+    run_for(world, 5.0)
+    end = body_pose(world, "puck0/puck")
+    assert after_3s[0] - 0.5 < 0.08 and abs(end[0] - after_3s[0]) < 1e-3, (after_3s, end)
+    assert abs(end[2] - PUCK.radius) < 2e-3, "still on its side"
+
+
 # -- box pushing (Parker §6.1) ------------------------------------------------------------------------------
 def box_pose(world) -> np.ndarray:
     position, rotation = frame_of(world, mujoco.mjtObj.mjOBJ_BODY, "box0/box")
