@@ -84,7 +84,10 @@ modified A* on a known map and follows the path with FRC; ``HRDU`` maps with an 
 re-plans. Each is ``__call__(Observation) -> Command``. Between positioning fixes (0.6 s apart) a controller
 advances its last fix by the velocities it commanded. The IR ring sees only a few directions (10-14 beams for
 41 candidate directions), so a controller keeps the obstacle points of the last ``obstacle_memory`` seconds, in
-its odometry frame so that a fix's jump does not smear them.
+its odometry frame so that a fix's jump does not smear them. Eight seconds (a choice): a box corner that juts
+out between two beams is seen only from further off, and in the kinematic study Robot B met such corners about
+5 s after last seeing them; with 2 s it had forgotten them and drove into them (and, halted against a corner no
+beam saw, stayed there).
 """
 from __future__ import annotations
 
@@ -646,7 +649,7 @@ class DynamicWindowController:
                  direction: DirectionSensorParams = DirectionSensorParams(), centre_offset: float = 0.0,
                  sensor_radius: float | np.ndarray | None = None, steering=SteeringGeometry(),
                  control_dt: float = 0.1,
-                 obstacle_memory: float = 2.0):
+                 obstacle_memory: float = 8.0):
         self.window = DynamicWindow(limits, kind, footprint_radius, method=self.method, params=params,
                                     centre_offset=centre_offset, steering=steering, control_dt=control_dt)
         self.goal = (float(goal[0]), float(goal[1]))

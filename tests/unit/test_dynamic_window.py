@@ -370,6 +370,14 @@ def test_obstacle_points_are_remembered_for_a_while():
     assert len(controller._remember(observation(1.5, bearings=[0.0]))) == 0
 
 
+
+def test_a_corner_seen_five_seconds_ago_is_still_remembered():
+    # Robot B, kinematic 20 % world 20008: a box corner between two beams was last seen 5.3 s before the robot
+    # turned into it; remembering 2 s, FRC had forgotten it.
+    controller = FRC(LIMITS, "diffdrive", 0.35, goal=(5.0, 0.0))
+    controller._remember(observation(0.0, ranges=[1.0], bearings=[0.0]))
+    assert len(controller._remember(observation(5.5, bearings=[0.0]))) == 1
+
 def test_obstacle_points_use_each_sensors_distance_from_the_centre():
     # A pentagon's sensors: the one looking forward sits on a vertex 0.5 m out, the one looking left on a side.
     controller = FRC(LIMITS, "diffdrive", 0.5, goal=(5.0, 0.0), sensor_radius=[0.5, 0.405])
