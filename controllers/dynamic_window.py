@@ -37,7 +37,8 @@ Per cycle (Fig 3.6, Fig 3.7):
      whose centre moves towards a flagged obstacle (it lies ahead, within the robot's half-width of the line of
      motion) are rejected. SM "is added to the robot's perimeter to allow it to stop or reverse before
      colliding", so DC_cd and the stopping test below use the circle enlarged by SM [RECON]: the robot stops at
-     the margin, not at the obstacle.
+     the margin, not at the obstacle. A point already inside the enlarged circle is measured against the robot's
+     own circle (the margin's test only looks along the line of motion, not along the arc).
   6. Per candidate: curvature constraint, distance to collision DC_cd of the enclosing circle along the centre's
      arc (Arras et al.'s exact method for polygons is replaced by the enclosing circle, as §3.4 does), the
      tricycle's DCF reduction towards a close side obstacle CL_ob, the stopping tests ST_v (3.33) and ST_omega
@@ -83,7 +84,10 @@ modified A* on a known map and follows the path with FRC; ``HRDU`` maps with an 
 re-plans. Each is ``__call__(Observation) -> Command``. Between positioning fixes (0.6 s apart) a controller
 advances its last fix by the velocities it commanded. The IR ring sees only a few directions (10-14 beams for
 41 candidate directions), so a controller keeps the obstacle points of the last ``obstacle_memory`` seconds, in
-its odometry frame so that a fix's jump does not smear them.
+its odometry frame so that a fix's jump does not smear them. Eight seconds (a choice): a box corner that juts
+out between two beams is seen only from further off, and in the kinematic study Robot B met such corners about
+5 s after last seeing them; with 2 s it had forgotten them and drove into them (and, halted against a corner no
+beam saw, stayed there).
 """
 from __future__ import annotations
 
@@ -321,8 +325,11 @@ class DynamicWindow:
     def collision_distances(self, v: np.ndarray, omega: np.ndarray, points: np.ndarray,
                             margin: float = 0.0) -> np.ndarray:
         """DC_cd: how far the centre travels along each candidate's arc before the enclosing circle, enlarged by
-        ``margin``, touches an obstacle point, capped at DC_cdmax. Points already inside it are left to the
-        safety margin's test (they reject motion towards them).
+        ``margin``, touches an obstacle point, capped at DC_cdmax. A point already inside the enlarged circle
+        (flagged by the safety margin) is measured against the robot's own circle instead [RECON]: the margin's
+        test rejects only motion straight towards it, so without this an arc that curves into a flagged point
+        would count as collision-free, and robots drove round into the box corners beside them. Points inside
+        the robot's own circle are left to the safety margin's test.
 
         [RECON] A candidate that does not move the centre (a stop, a point turn) has no path to measure along; it
         is given the clearance it keeps, the enlarged circle's distance to the nearest point (0 if one is inside
@@ -334,10 +341,12 @@ class DynamicWindow:
         distance = np.hypot(points[:, 0], points[:, 1])
         kept = float(np.clip(distance.min() - r, 0.0, p.dc_max)) if points.shape[0] else p.dc_max
         turning = np.abs(omega) > 1e-9
-        moving = (np.abs(v) > 1e-9) | (turning & (abs(self.offset) > 1e-9))
-        pts = points[distance >= r]
+        moving = ~self.in_place(v, omega)
+        outside = distance >= self.radius
+        pts = points[outside]
         if pts.shape[0] == 0:
             return np.where(moving, p.dc_max, kept)
+        r = np.where(distance[outside] >= r, r, self.radius)[None, :]  # per point: see above
         px, py = pts[:, 0][None, :], pts[:, 1][None, :]
         # Straight: travel along +-x until a point enters the circle.
         forward = np.sign(v)[:, None]
@@ -360,22 +369,31 @@ class DynamicWindow:
         travel = np.where(turning[:, None], arc, straight).min(axis=1)
         return np.where(moving, np.minimum(travel, p.dc_max), kept)
 
+    def in_place(self, v: np.ndarray, omega: np.ndarray) -> np.ndarray:
+        """Candidates that leave the robot's centre where it is: a stop, and a point turn about the centre
+        (a differential drive's; a tricycle's centre is ahead of its rear axle and cannot turn in place)."""
+        return (np.abs(v) <= 1e-9) & ((np.abs(omega) <= 1e-9) | (abs(self.offset) <= 1e-9))
+
     def stops_clear(self, v: np.ndarray, omega: np.ndarray, points: np.ndarray, margin: float) -> np.ndarray:
         """ST_v by integration: whether, holding each candidate for one cycle and then braking at a_a along its
         curvature (omega following c v as fast as the drive's angular acceleration allows), the circle enlarged
-        by ``margin`` stays clear of every obstacle point outside it."""
+        by ``margin`` stays clear of every obstacle point outside it, and the robot's own circle of every point
+        between the two (as in ``collision_distances``)."""
         p, lim = self.params, self.limits
         r = self.radius + margin
-        pts = points[np.hypot(points[:, 0], points[:, 1]) >= r]
+        distance = np.hypot(points[:, 0], points[:, 1])
+        pts = points[distance >= self.radius]
         clear = np.ones(v.size, bool)
         if pts.shape[0] == 0:
             return clear
+        radii = np.where(distance[distance >= self.radius] >= r, r, self.radius)
         speed, w = np.abs(v), omega.copy()
         brake = min(p.a_a, lim.accel_max)
         # Only points the enlarged circle can reach: the centre moves at most the reference point's stopping
         # path plus the offset swung round.
         path = speed.max() * self.dt + speed.max() ** 2 / (2 * brake) + 0.1
-        pts = pts[np.hypot(pts[:, 0], pts[:, 1]) < r + path + 2 * np.pi * abs(self.offset)]
+        reach = np.hypot(pts[:, 0], pts[:, 1]) < r + path + 2 * np.pi * abs(self.offset)
+        pts, radii = pts[reach], radii[reach]
         if pts.shape[0] == 0:
             return clear
         moving = speed > 1e-9
@@ -399,7 +417,7 @@ class DynamicWindow:
             # The centre, ``offset`` ahead of the reference point, relative to where the centre started.
             cx, cy = x + self.offset * (np.cos(th) - 1.0), y + self.offset * np.sin(th)
             d2 = (pts[:, 0][None, :] - cx[:, None]) ** 2 + (pts[:, 1][None, :] - cy[:, None]) ** 2
-            clear &= (d2 >= r * r).all(axis=1)
+            clear &= (d2 >= radii[None, :] ** 2).all(axis=1)
             speed, w = next_speed, next_w
             if not held and not speed.any():
                 return clear
@@ -458,7 +476,11 @@ class DynamicWindow:
         if self.tricycle and self.method is Method.FRC:
             dc = np.where(steers_to_close, dc * p.dcf, dc)
 
-        st_v = (dc > 0) & self.stops_clear(v, omega, points, margin)  # (3.33) by integration [RECON]
+        # (3.33) by integration [RECON]. A candidate that leaves the centre where it is (a stop; a differential
+        # drive's point turn) sweeps nothing new: it can always stop, even with an obstacle inside the margin.
+        # Its DC_cd (the clearance it keeps) still sets the alpha_3 scaling of (3.35).
+        in_place = self.in_place(v, omega)
+        st_v = in_place | ((dc > 0) & self.stops_clear(v, omega, points, margin))
         if self.tricycle:
             st_w = np.ones(v.size, bool)  # §3.5: tricycles check ST_v only
         else:
@@ -627,7 +649,7 @@ class DynamicWindowController:
                  direction: DirectionSensorParams = DirectionSensorParams(), centre_offset: float = 0.0,
                  sensor_radius: float | np.ndarray | None = None, steering=SteeringGeometry(),
                  control_dt: float = 0.1,
-                 obstacle_memory: float = 2.0):
+                 obstacle_memory: float = 8.0):
         self.window = DynamicWindow(limits, kind, footprint_radius, method=self.method, params=params,
                                     centre_offset=centre_offset, steering=steering, control_dt=control_dt)
         self.goal = (float(goal[0]), float(goal[1]))

@@ -77,10 +77,12 @@ def _towards(v: float, omega: float, points: list[tuple[float, float]], offset: 
 
 
 def _collision_distance(v: float, omega: float, points: list[tuple[float, float, float]], r: float,
-                        offset: float, kept: float, dc_max: float) -> float:
+                        offset: float, kept: float, dc_max: float, radius: float) -> float:
     """DC_cd of one candidate: the centre's travel along its arc (or line) until the circle of radius ``r`` touches
-    one of ``points`` (x, y, distance from the centre; those already inside it are left out), capped at
-    DC_cdmax; ``kept`` (the clearance) for a candidate that does not move the centre."""
+    one of ``points`` (x, y, distance from the centre; those inside the robot's own circle of ``radius`` are left
+    out, and those between it and ``r`` are measured against it), capped at DC_cdmax; ``kept`` (the clearance)
+    for a candidate that does not move the centre."""
+    enlarged = r
     turning = abs(omega) > 1e-9
     if not (abs(v) > 1e-9 or (turning and abs(offset) > 1e-9)):
         return kept
@@ -90,7 +92,8 @@ def _collision_distance(v: float, omega: float, points: list[tuple[float, float,
         rho = math.hypot(offset, icr_y)
         centre_angle = math.atan2(-icr_y, offset)
         turn_sign = _sign(omega)
-        for px, py, _ in points:
+        for px, py, dist in points:
+            r = enlarged if dist >= enlarged else radius
             qx, qy = px + offset, py - icr_y
             d = math.hypot(qx, qy)
             if abs(d - rho) < r:
@@ -100,19 +103,20 @@ def _collision_distance(v: float, omega: float, points: list[tuple[float, float,
                 travel = min(travel, rho * max(ahead_angle - touch, 0.0))
     else:  # straight along +-x
         forward = _sign(v)
-        for px, py, _ in points:
+        for px, py, dist in points:
+            r = enlarged if dist >= enlarged else radius
             ahead = forward * px
             if ahead > 0 and abs(py) < r:
                 travel = min(travel, ahead - math.sqrt(max(r * r - py * py, 0.0)))
     return min(travel, dc_max)
 
 
-def _stops_clear(v: float, omega: float, points: list[tuple[float, float]], r: float, window: DynamicWindow,
+def _stops_clear(v: float, omega: float, points: list[tuple[float, float, float]], window: DynamicWindow,
                  braking_steps: int) -> bool:
     """ST_v by integration, for one candidate: held one cycle, then braking at a_a along its curvature with omega
     slewed at the drive's angular limit, two cycles a step, for ``braking_steps`` steps (as many as the fastest
     candidate of the window needs to stop: the turn rate keeps settling after a slower one has); whether the
-    circle of radius ``r`` stays clear of every point."""
+    circle stays clear of every point (x, y, the circle's radius for that point)."""
     p, lim, dt0, offset = window.params, window.limits, window.dt, window.offset
     brake = min(p.a_a, lim.accel_max)
     speed, w = abs(v), omega
@@ -120,7 +124,6 @@ def _stops_clear(v: float, omega: float, points: list[tuple[float, float]], r: f
     curvature = omega / v if moving else 0.0
     direction = _sign(v)
     x = y = th = 0.0
-    r2 = r * r
     for step_index in range(braking_steps + 1):
         held = step_index == 0
         dt = dt0 if held else 2 * dt0
@@ -135,8 +138,8 @@ def _stops_clear(v: float, omega: float, points: list[tuple[float, float]], r: f
         mid = th + mean_w * dt / 2
         x, y, th = x + step * math.cos(mid), y + step * math.sin(mid), th + mean_w * dt
         cx, cy = x + offset * (math.cos(th) - 1.0), y + offset * math.sin(th)
-        for px, py in points:
-            if (px - cx) ** 2 + (py - cy) ** 2 < r2:
+        for px, py, rr in points:
+            if (px - cx) ** 2 + (py - cy) ** 2 < rr * rr:
                 return False
         speed, w = next_speed, next_w
     return True
@@ -211,11 +214,11 @@ def reference_decide(window: DynamicWindow, state: DriveState, points, heading: 
     r = radius + margin
     flagged = [(x, y) for x, y, dist in pts if dist - radius <= margin]
     kept = _clip(min(dist for _, _, dist in pts) - r, 0.0, p.dc_max) if pts else p.dc_max
-    outside = [pt for pt in pts if pt[2] >= r]
+    outside = [pt for pt in pts if pt[2] >= radius]  # flagged ones are measured against the robot's own circle
     fastest = max(abs(v) for v, _ in candidates)
     brake = min(p.a_a, lim.accel_max)
     reach = r + (fastest * dt + fastest ** 2 / (2 * brake) + 0.1) + TWO_PI * abs(offset)  # as FRC sums it
-    stop_points = [(x, y) for x, y, dist in outside if dist < reach]
+    stop_points = [(x, y, r if dist >= r else radius) for x, y, dist in outside if dist < reach]
     braking_steps = _braking_steps(fastest, brake, 2 * dt)
     left = right = False
     if window.tricycle:  # CL_ob: a point close to the rim on either side
@@ -240,10 +243,12 @@ def reference_decide(window: DynamicWindow, state: DriveState, points, heading: 
                 cc = c_min - 1e-9 <= c <= c_max + 1e-9
                 steers_to_close = (left and c > 1e-9) or (right and c < -1e-9)
             admissible = admissible and cc
-        dc = _collision_distance(v, w, outside, r, offset, kept, p.dc_max)
+        dc = _collision_distance(v, w, outside, r, offset, kept, p.dc_max, radius)
         if steers_to_close:
             dc = dc * p.dcf
-        st_v = dc > 0 and (not stop_points or _stops_clear(v, w, stop_points, r, window, braking_steps))  # (3.33)
+        # (3.33); a stop or a point turn about the centre sweeps nothing new and can always stop
+        in_place = still and (abs(w) < 1e-9 or abs(offset) < 1e-9)
+        st_v = in_place or (dc > 0 and (not stop_points or _stops_clear(v, w, stop_points, window, braking_steps)))
         st_w = True if window.tricycle else (dc > 0 and dc > w ** 2 / (2 * alpha_min))  # (3.34)
         turned = w * dt + w * abs(w) / (2 * lim.angular_accel_max)
         h = 1.0 - abs(_wrap(heading - turned)) / math.pi

@@ -139,6 +139,32 @@ def test_at_rest_in_a_narrow_gap_a_differential_robot_moves_on():
     assert decision.branch == "primary" and decision.v > 0
 
 
+
+def test_at_rest_beside_an_obstacle_inside_the_margin_a_differential_robot_turns_away():
+    # An obstacle point 5 cm from the rim at 60 degrees left, the target to the right: every way forward moves
+    # the centre towards it and reversing is not permitted, so only a point turn is left. It sweeps nothing, so it
+    # can always stop; given the clearance it keeps (0 inside the margin) as DC_cd it failed ST_v, and the robot
+    # stood there for good (the kinematic study's Robot B, 20 % world 20005).
+    point = 0.40 * np.array([[math.cos(math.pi / 3), math.sin(math.pi / 3)]])
+    decision = differential().decide(DriveState(), point, heading=-1.5, d_tgt=9.0)
+    assert decision.branch == "primary"
+    assert decision.v == 0.0 and decision.omega < 0.0
+
+
+def test_an_arc_into_an_obstacle_inside_the_margin_is_not_collision_free():
+    # Moving at 0.4 m/s the margin is 0.14 m; a point 8 cm from the rim, ahead and to the left, is flagged but off
+    # the line of motion, so the margin's test lets a left turn through. DC_cd must still see it, against the
+    # robot's own circle: left out, the arc counted as free (DC_cdmax) and robots turned into box corners.
+    dw = differential()
+    point = np.array([[0.43 * math.cos(math.radians(55)), 0.43 * math.sin(math.radians(55))]])
+    v, omega = np.array([0.4]), np.array([0.3])
+    margin = PARAMS.sm_min + PARAMS.k_sm * 0.4
+    assert not dw.towards(v, omega, point)[0]
+    dc = dw.collision_distances(v, omega, point, margin)[0]
+    assert dc == pytest.approx(brute_force_collision_distance(0.4, 0.3, point.tolist(), 0.35, 0.0), abs=2e-4)
+    assert dc < 0.2
+    assert not dw.stops_clear(v, omega, point, margin)[0]
+
 def brute_force_collision_distance(v, omega, points, radius, offset):
     """March the reference point along its arc and watch the enclosing circle round the offset centre."""
     x = y = th = travelled = 0.0
@@ -343,6 +369,14 @@ def test_obstacle_points_are_remembered_for_a_while():
     assert len(controller._remember(observation(0.5, bearings=[0.0]))) == 1
     assert len(controller._remember(observation(1.5, bearings=[0.0]))) == 0
 
+
+
+def test_a_corner_seen_five_seconds_ago_is_still_remembered():
+    # Robot B, kinematic 20 % world 20008: a box corner between two beams was last seen 5.3 s before the robot
+    # turned into it; remembering 2 s, FRC had forgotten it.
+    controller = FRC(LIMITS, "diffdrive", 0.35, goal=(5.0, 0.0))
+    controller._remember(observation(0.0, ranges=[1.0], bearings=[0.0]))
+    assert len(controller._remember(observation(5.5, bearings=[0.0]))) == 1
 
 def test_obstacle_points_use_each_sensors_distance_from_the_centre():
     # A pentagon's sensors: the one looking forward sits on a vertex 0.5 m out, the one looking left on a side.

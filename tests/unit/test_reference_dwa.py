@@ -88,7 +88,11 @@ def test_reference_matches_frc_on_every_branch_in_random_scenes(name):
         v, omega, branch, v_min = reference_decide(window, *args)
         branches.add(frc.branch)
         assert (v, omega, branch, v_min) == pytest.approx((frc.v, frc.omega, frc.branch, frc.v_min), abs=1e-9), args
-    assert branches == {"primary", "secondary", "curvature", "brake"}
+    # A differential drive never reaches the average-curvature fallback: whenever its window holds v = 0 a stop
+    # or a point turn about its centre is admissible (it sweeps nothing), and otherwise the fallback's velocity,
+    # the same as the secondary search's, moves its centre straight towards what made that search fail.
+    expected = {"primary", "secondary", "brake"} | ({"curvature"} if name == "tricycle" else set())
+    assert branches == expected
 
 
 def test_reference_is_not_blind():
