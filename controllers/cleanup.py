@@ -485,7 +485,8 @@ class MoveSpill(SetController):
                 self.knowledge.hint = lost_at  # (near the goal it is as good as delivered: leave it)
             return self._begin("recover", [G.Release(self.sensors, self.params.gripper)], obs)
         if self.step.status == G.SUCCEEDED:
-            return self._begin("drop", [G.Lower(self.sensors, self.params.gripper), G.Release(self.sensors, self.params.gripper)], obs)
+            g = self.sensors, self.params.gripper
+            return self._begin("drop", [G.Lower(*g), G.Release(*g)], obs)
         return replace(command, behaviour=self.name)
 
     def _drop(self, obs: Observation) -> Command:

@@ -2,8 +2,9 @@
 
 :class:`AvoidObstacles` is the lowest competence layer of every R-2 behaviour set: when a bump sensor fires or
 an IR sensor sees something closer than ``avoid_range``, it takes over for a short manoeuvre (move off away from
-it, then turn away from the side that sensed it: right when it was dead ahead, a random side when behind), then hands control back. Parker's
-move-spill suppresses it while picking up, so that the robot can drive its jaw around a puck.
+it, then turn away from the side that sensed it: right when it was dead ahead, a random side when behind), then
+hands control back. Parker's move-spill suppresses it while picking up, so that the robot can drive its jaw
+around a puck.
 
 :class:`Unstick` lies under it: a robot asked to move that the positioning service shows going nowhere raises
 its lift and backs off. Parker's R-2s lowered their jaw onto pucks they could not sense under the fingers and
@@ -129,7 +130,8 @@ class Unstick:
     with ``escape_extras`` overriding the command's extras meanwhile (an R-2 raises its lift, freeing the wheels;
     its grip is left as commanded, so a held load stays held). ``escapes`` counts them."""
 
-    def __init__(self, rng: np.random.Generator, params: DriveParams = DriveParams(), escape_extras: dict | None = None):
+    def __init__(self, rng: np.random.Generator, params: DriveParams = DriveParams(),
+                 escape_extras: dict | None = None):
         self.rng = rng
         self.params = params
         self.escape_extras = dict(escape_extras or {})
@@ -140,29 +142,35 @@ class Unstick:
 
     def __call__(self, obs: Observation, command: Command) -> Command:
         p = self.params
-        if obs.time < self.until:
-            v, omega = (-p.back_speed, 0.0) if obs.time < self.back_until else (0.0, self.turn)
-            return replace(command, v=v, omega=omega, extras={**command.extras, **self.escape_extras})
-        if abs(command.v) < p.stuck_speed and abs(command.omega) < p.stuck_turn_rate:
-            self.fixes.clear()
-            return command
-        fix = obs.pose
+        if obs.time >= self.until:
+            if abs(command.v) < p.stuck_speed and abs(command.omega) < p.stuck_turn_rate:
+                self.fixes.clear()
+                return command
+            self._add_fix(obs.pose)
+            if not self._stuck(obs.time):
+                return command
+            self._begin_escape(obs.time)
+        v, omega = (-p.back_speed, 0.0) if obs.time < self.back_until else (0.0, self.turn)
+        return replace(command, v=v, omega=omega, extras={**command.extras, **self.escape_extras})
+
+    def _add_fix(self, fix) -> None:
+        """Keep a fix not seen before."""
         if fix is not None and (not self.fixes or fix.time > self.fixes[-1][0]):
             self.fixes.append((fix.time, fix.x, fix.y, fix.heading))
-        if self._stuck(obs.time):
-            self.fixes.clear()
-            self.escapes += 1
-            self.back_until = obs.time + p.unstick_back_time
-            self.until = self.back_until + p.turn_time
-            self.turn = self.rng.choice((-1.0, 1.0)) * p.turn_rate
-            return self(obs, command)
-        return command
+
+    def _begin_escape(self, now: float) -> None:
+        p = self.params
+        self.fixes.clear()
+        self.escapes += 1
+        self.back_until = now + p.unstick_back_time
+        self.until = self.back_until + p.turn_time
+        self.turn = self.rng.choice((-1.0, 1.0)) * p.turn_rate
 
     def _stuck(self, now: float) -> bool:
         p = self.params
         if not self.fixes or now - self.fixes[0][0] < p.stuck_window:
             return False
-        while len(self.fixes) > 1 and now - self.fixes[1][0] >= p.stuck_window:  # keep one fix at least stuck_window old
+        while len(self.fixes) > 1 and now - self.fixes[1][0] >= p.stuck_window:  # one fix stuck_window old stays
             self.fixes.popleft()
         _, x, y, heading = np.array(self.fixes).T
         spread = np.hypot(x - x.mean(), y - y.mean()).max()

@@ -63,10 +63,7 @@ def place(arena: mjcf.RootElement, thing: mjcf.RootElement, x: float, y: float, 
           z: float = 0.0, damping: float = 0.0) -> mjcf.Element:
     """Attach a free object into the arena at (x, y, z) with heading ``yaw`` (and ``damping`` on its motion)."""
     frame = arena.attach(thing)
-    if damping > 0:
-        frame.add("joint", type="free", damping=damping)
-    else:
-        frame.add("freejoint")
+    frame.add("joint", type="free", damping=damping)
     frame.pos = [x, y, z]
     frame.euler = [0, 0, yaw]
     return frame

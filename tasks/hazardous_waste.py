@@ -233,7 +233,8 @@ class HazardousWasteMission(ScenarioMission):
             "find_locations_by": sorted(n for n, r in robots.items()
                                         if any(r["task_time_s"].get(s, 0) > 0 for s in find_sets)),
             "per_robot": {n: {"transports": b.knowledge.transports, "reports": b.knowledge.reports,
-                              "escapes": b.unstick.escapes, "located": b.knowledge.located, **believed_locations(b.knowledge)}
+                              "escapes": b.unstick.escapes, "located": b.knowledge.located,
+                              **believed_locations(b.knowledge)}
                           for n, b in brains.items()},
             "task_time_s": {task: round(sum(r["task_time_s"].get(s, 0.0) for r in robots.values()
                                             for s in sets), 3)
