@@ -61,6 +61,9 @@ class CleanupParams:
     follow_speed: float = 0.25  # m/s
     home_leave: float = 2.0  # m: wall-following ends back within home_return of home after going this far
     home_return: float = 0.8
+    # s of curving right without the wall before it is sought again straight ahead to the right: a full circle
+    # at the lost-wall curve takes 7 s, and a robot pushed 0.4 m off the wall circled on the spot for 1800 s
+    wall_lost_time: float = 8.0
     # find-wander (see FindWander): s of driving per compass direction (a 7.9 m room at 0.3 m/s is 26 s), and at
     # most wander_leg_limit s per direction in all
     wander_leg: float = 30.0
@@ -82,7 +85,10 @@ class CleanupParams:
     # room: with 16 (3 m) a team stopped with 5 pucks at the goal and one 0.5 m from the spill (kill-red seed 5)
     empty_lines: int = 32
     goal_spread: float = 0.25  # m: deliveries land this far either side of the believed goal
-    goal_keepout: float = 1.5  # m: pucks this near the believed goal are never searched for (they are moved)
+    # m: pucks this near the believed goal are never searched for (they are delivered). Delivered pucks were
+    # measured up to 0.8 m from it; with 1.5 m, pucks pushed just out of the goal zone by robots arriving to
+    # deliver (0.9-1.3 m from it) were never searched for and two missions ended 1-2 pucks short
+    goal_keepout: float = 0.9
     goal_clearance: float = 0.45  # m: the drop point stands this far in from the goal-side extent
     arrive: float = 0.2  # m: a waypoint is reached within this
     lane_offset: float = 0.5  # m to the right of the direct line while travelling (keep right)
@@ -243,6 +249,8 @@ class FindMethodical(ExtentTracker):
         super().restart()
         self.found_wall = False
         self.far_from_home = False
+        self.seek_heading = -math.pi / 2  # the first wall is sought to the south
+        self.wall_lost: tuple | None = None  # (time, heading) when the side IR last lost the wall
 
     def __call__(self, obs: Observation) -> Command:
         p, home = self.params, self.knowledge.home
@@ -254,18 +262,31 @@ class FindMethodical(ExtentTracker):
         ahead = min(obs.ir_range[self.tips])
         front, rear = obs.ir_range[self.side]
         if ahead < p.wall_ahead:
-            self.found_wall = True
+            self.found_wall, self.wall_lost = True, None
             return self.drive(0.0, p.drive.turn_rate)  # a corner (or a robot): turn left
         if not self.found_wall:
-            omega = turn_to(self.estimate.pose, -math.pi / 2, p.drive)  # head south to the first wall
+            omega = turn_to(self.estimate.pose, self.seek_heading, p.drive)
             return self.drive(0.0 if omega else p.follow_speed, omega or 0.0)
         if not (np.isfinite(front) or np.isfinite(rear)):
-            return self.drive(0.5 * p.follow_speed, -0.6 * p.drive.turn_rate)  # lost the wall: curve right
+            return self._lost_wall(obs.time)
+        self.wall_lost = None
         nearest = min(front, rear)
         omega = -3.0 * (nearest - p.wall_distance)
         if np.isfinite(front) and np.isfinite(rear):
             omega -= 4.0 * (front - rear)
         return self.drive(p.follow_speed, float(np.clip(omega, -p.drive.turn_rate, p.drive.turn_rate)))
+
+    def _lost_wall(self, now: float) -> Command:
+        """Curve right round the corner the wall turned; if no wall comes back within ``wall_lost_time`` (the
+        robot was pushed off it), seek it straight ahead in the direction it was in when lost: to the right."""
+        p = self.params
+        if self.wall_lost is None:
+            self.wall_lost = (now, float(self.estimate.pose[2]))
+        if now - self.wall_lost[0] >= p.wall_lost_time:
+            self.found_wall, self.seek_heading = False, self.wall_lost[1] - math.pi / 2
+            self.wall_lost = None
+            return self.drive()
+        return self.drive(0.5 * p.follow_speed, -0.6 * p.drive.turn_rate)
 
 
 class FindWander(ExtentTracker):

@@ -256,3 +256,41 @@ def test_sweep_lines_aim_inside_the_room_and_away_from_the_goal():
     assert (np.abs(points[:, 0]) <= 3.7 + 1e-9).all() and (np.abs(points[:, 1]) <= 1.6 + 1e-9).all()
     assert (np.hypot(*(points - np.array(found["goal"])).T) > params.goal_keepout).all()
     assert np.hypot(*(points - np.array(found["spill"])).T).max() > 3.0  # and the search does reach down the room
+
+
+def test_find_methodical_pushed_off_the_wall_seeks_it_again_to_its_right():
+    """Red following the north wall westwards (wall on its right) is pushed 0.45 m off it: its side IR (0.3 m)
+    loses the wall. It curves right for ``wall_lost_time``, then drives north (right of west, where the wall was),
+    follows the wall round the corner and concludes back home; with only the curve it circled on the spot
+    (radio-off seed 3, 1800 s)."""
+    from teamsim.controllers.cleanup import CleanupParams, FindMethodical
+    from teamsim.models import build_robot
+    from teamsim.models.r2 import R2Dims
+
+    robot = build_robot("r2", "red")
+    params = CleanupParams()
+    estimate = _Pose(0.0, 1.83 - 0.15 - 0.45, math.pi)
+    knowledge = CleanupKnowledge(report_interval=240.0, home=np.array([-3.2, -0.6]))
+    methodical = FindMethodical(robot, knowledge, estimate, None, params)
+    methodical.found_wall, methodical.far_from_home = True, True
+    tips = [robot.ir_sensors.index(n) for n in ("ir_tip_left", "ir_tip_right")]
+    side = [robot.ir_sensors.index(n) for n in ("ir_right_front", "ir_right_rear")]
+    track = []
+    for tick in range(round(40.0 / 0.1)):
+        ranges = np.full(len(robot.ir_sensors), np.inf)
+        ranges[tips] = _tip_range(estimate.pose, [])
+        x, y, heading = estimate.pose
+        to_side = _tip_range((x, y, heading - math.pi / 2), [], nose=R2Dims().width / 2)
+        ranges[side] = to_side if to_side <= R2Dims().ir_range else np.inf
+        command = methodical(Observation(time=tick * 0.1, robot="red", ir_raw=ranges, ir_range=ranges,
+                                         ir_bearings=robot.ir_bearings, pose=None))
+        estimate.pose = np.array([x + command.v * 0.1 * math.cos(heading), y + command.v * 0.1 * math.sin(heading),
+                                  heading + command.omega * 0.1])
+        track.append(estimate.pose.copy())
+    track = np.array(track)
+    circling = track[: round(params.wall_lost_time / 0.1)]
+    assert np.ptp(circling[:, 1]) < 0.4  # the lost-wall curve alone stays put
+    back = track[round(params.wall_lost_time / 0.1):]
+    assert back[:, 1].max() > 1.83 - 0.127 - 0.3  # back within side-IR range of the north wall
+    assert back[:, 0].min() < -3.4  # followed it west to the corner and on round it
+    assert knowledge.located  # and closed the loop at home
