@@ -194,13 +194,14 @@ CAUSES = {
             "candidate of FRC by 0.01, which changes FRC's choices only against candidates that keep DC_cdmin "
             "clear; where those are rare, FRC creeps and RFRC does not.",
     "success": "FRC is purely reactive and sees obstacles in only 10-14 directions. Failures are either stalls "
-               "(the robot stops, or rocks to and fro, against obstacles: a tricycle wedged at full lock cannot "
-               "turn in place, and (3.23) allows reversing only when the nearest front obstacle is within "
-               "d_obfrT2, so from some poses no candidate is admissible) or wandering in the local minima of "
-               "pure reactive control. In a physics-free check with ideal sensors (docs/navigation.md), most of "
-               "Robot B's collisions at 20 % came from box corners between its 10 beams and vanished with 72 "
-               "beams; the thesis's simulator and its obstacles' sizes are not described well enough to say "
-               "which of these it avoided.",
+               "or wandering in the local minima of pure reactive control (rocking to and fro at a gap narrower "
+               "than its safety margin allows, looping in pockets). Robot A's stalls have one cause, traced in "
+               "the kinematic trials: a tricycle's front wheel does not steer at rest (its angle follows "
+               "atan(omega L / v), held at v ~ 0); stopped beside an obstacle with the wheel turned towards it, "
+               "DCF = 0 rejects every forward candidate, the obstacle lies outside the +-50 deg front sector so "
+               "(3.23) does not allow reversing, and 'oppose the current motion' from rest is v = 0, so it stays. "
+               "The thesis's simulator and its obstacles' sizes are not described well enough to say how it "
+               "avoided this.",
 }
 
 
