@@ -448,12 +448,15 @@ class MoveSpill(SetController):
         return math.atan2(dy, dx), math.hypot(dx, dy) + p.sweep_overshoot, None
 
     def _searchable(self, point: np.ndarray) -> bool:
-        """Within the extents the finder reached (the room, less the robot's own clearance) and farther than
-        ``goal_keepout`` from the goal."""
-        k = self.knowledge
-        xmin, xmax, ymin, ymax = k.extents
+        """Within the extents the finder reached (the room, less the robot's own clearance) and not at the
+        goal."""
+        xmin, xmax, ymin, ymax = self.knowledge.extents
         inside = xmin <= point[0] <= xmax and ymin <= point[1] <= ymax
-        return inside and math.hypot(*(point - np.asarray(k.goal))) > self.params.goal_keepout
+        return inside and not self._at_goal(point)
+
+    def _at_goal(self, point) -> bool:
+        """Within ``goal_keepout`` of the believed goal, where the delivered pucks lie."""
+        return math.dist(point, self.knowledge.goal) <= self.params.goal_keepout
 
     def _reach(self) -> float:
         """Radius of the search area: pucks get pushed about, so it widens as lines find nothing. (The robot may
@@ -502,7 +505,7 @@ class MoveSpill(SetController):
         command = self.step(obs)
         if self.step.status == G.FAILED:  # lost the load on the way: open up and look for it here
             lost_at = self._jaw_position()
-            if np.hypot(*(np.subtract(lost_at, self.knowledge.goal))) > self.params.goal_keepout:
+            if not self._at_goal(lost_at):
                 self.knowledge.hint = lost_at  # (near the goal it is as good as delivered: leave it)
             return self._begin("recover", [G.Release(self.sensors, self.params.gripper)], obs)
         if self.step.status == G.SUCCEEDED:

@@ -161,6 +161,12 @@ class _Pose:
     def __init__(self, x, y, heading):
         self.pose = np.array([x, y, heading], float)
 
+    def drive(self, command, dt: float = 0.1) -> None:
+        """Follow ``command`` for ``dt`` (unicycle, Euler step)."""
+        x, y, heading = self.pose
+        self.pose = np.array([x + command.v * dt * math.cos(heading), y + command.v * dt * math.sin(heading),
+                              heading + command.omega * dt])
+
 
 def _tip_range(pose, boxes, half_x=3.96, half_y=1.83, nose=0.2) -> float:
     """Distance from the jaw's front straight ahead to the first wall or box face (boxes: (x0, x1, y0, y1))."""
@@ -206,10 +212,7 @@ def _wander_east(boxes, seconds=90.0):
             break
         ranges = np.full(len(robot.ir_sensors), np.inf)
         ranges[tips] = _tip_range(estimate.pose, boxes)
-        command = wander(observe(tick * 0.1, ranges))
-        x, y, heading = estimate.pose
-        estimate.pose = np.array([x + command.v * 0.1 * math.cos(heading), y + command.v * 0.1 * math.sin(heading),
-                                  heading + command.omega * 0.1])
+        estimate.drive(wander(observe(tick * 0.1, ranges)))
         track.append(estimate.pose.copy())
     return np.array(track), wander
 
@@ -284,8 +287,7 @@ def test_find_methodical_pushed_off_the_wall_seeks_it_again_to_its_right():
         ranges[side] = to_side if to_side <= R2Dims().ir_range else np.inf
         command = methodical(Observation(time=tick * 0.1, robot="red", ir_raw=ranges, ir_range=ranges,
                                          ir_bearings=robot.ir_bearings, pose=None))
-        estimate.pose = np.array([x + command.v * 0.1 * math.cos(heading), y + command.v * 0.1 * math.sin(heading),
-                                  heading + command.omega * 0.1])
+        estimate.drive(command)
         track.append(estimate.pose.copy())
     track = np.array(track)
     circling = track[: round(params.wall_lost_time / 0.1)]
