@@ -1,7 +1,7 @@
 """The hazardous-waste cleanup behaviour sets of Parker's R-2s (§3.8.1, Figs 3-4 to 3-8; spec §4.1).
 
 Every robot carries :class:`CleanupKnowledge`: what it believes about the mission (its home by the entrance, the
-room's extents, the spill and goal locations, when the team last reported, whether the spill is gone), built
+room's extents, the spill and goal locations, when the team last reported, when the spill was last found empty), built
 from its own sensing and from teammates' broadcasts. The behaviour sets' sensory feedback is read from it:
 
 - find-initial-final-locations (task ``find-locations``): applicable while the locations are unknown. Two
@@ -20,7 +20,7 @@ from its own sensing and from teammates' broadcasts. The behaviour sets' sensory
   by radio, which satisfies its teammates.
 
 The robot that finds the locations broadcasts them (the virtual sensor of §3.8.2), and every broadcast also
-carries the last report time and the spill-empty belief. With the radio off nothing is shared, so every capable
+carries the last report time and when the spill was found empty (the belief lapses after ``empty_rest``). With the radio off nothing is shared, so every capable
 robot finds the locations and reports for itself (ch.5's "no awareness").
 
 The avoid-obstacles layer (:class:`teamsim.controllers.goto.AvoidObstacles`) runs under every set except while
@@ -84,6 +84,9 @@ class CleanupParams:
     # consecutive sweep lines without a puck: the spill is gone. By the 32nd the area has widened to 5.4 m, the whole
     # room: with 16 (3 m) a team stopped with 5 pucks at the goal and one 0.5 m from the spill (kill-red seed 5)
     empty_lines: int = 32
+    # s a spill-empty belief holds before the robots look again. Held for good, a team that found nothing in 32
+    # lines at 1000 s with 7 pucks home waited out the mission while idle robots parked by two of the pucks
+    empty_rest: float = 120.0
     goal_spread: float = 0.25  # m: deliveries land this far either side of the believed goal
     # m: pucks this near the believed goal are never searched for (they are delivered). Delivered pucks were
     # measured up to 0.8 m from it; with 1.5 m, pucks pushed just out of the goal zone by robots arriving to
@@ -128,6 +131,7 @@ def locations_from_extents(extents: np.ndarray, home: np.ndarray, clearance: flo
 class CleanupKnowledge:
     """One robot's beliefs about the mission, and its own tallies (transports, reports)."""
     report_interval: float
+    empty_rest: float = math.inf
     home: np.ndarray | None = None
     spill: tuple | None = None
     goal: tuple | None = None
@@ -136,7 +140,7 @@ class CleanupKnowledge:
     last_report: float = 0.0  # the mission's start counts as a report
     delivered_since_report: bool = False
     just_delivered: bool = False
-    spill_empty: bool = False
+    emptied_at: float | None = None  # when this robot, or a teammate it heard, last found the spill empty
     hint: tuple | None = None  # where this robot last had a puck: the next search starts there
     transports: int = 0
     reports: int = 0
@@ -144,6 +148,12 @@ class CleanupKnowledge:
     @property
     def located(self) -> bool:
         return self.goal is not None
+
+    def spill_empty(self, now: float) -> bool:
+        return self.emptied_at is not None and now - self.emptied_at < self.empty_rest
+
+    def found_empty(self, now: float) -> None:
+        self.emptied_at = now
 
     def learn_locations(self, locations: dict) -> None:
         if not self.located:
@@ -159,11 +169,12 @@ class CleanupKnowledge:
         if payload.get("report", -math.inf) > self.last_report:
             self.last_report = payload["report"]
             self.delivered_since_report = False
-        self.spill_empty |= bool(payload.get("spill_empty", False))
+        if payload.get("emptied_at") is not None:
+            self.emptied_at = max(self.emptied_at or -math.inf, payload["emptied_at"])
 
     def message(self) -> dict:
         """What this robot tells its teammates in every broadcast."""
-        shared = {"report": self.last_report, "spill_empty": self.spill_empty}
+        shared = {"report": self.last_report, "emptied_at": self.emptied_at}
         if self.located:
             shared.update(spill=self.spill, goal=self.goal, entrance=self.entrance, extents=self.extents)
         return shared
@@ -417,11 +428,11 @@ class MoveSpill(SetController):
             return self._begin("pick", [G.Approach(*g), G.Grasp(*g), G.Lift(*g)], obs)
         if obs.time - scanning_since > length / p.sweep_speed:
             self.line = None
-            self._nothing_found()
+            self._nothing_found(obs.time)
             return self.drive(-p.sweep_speed)
         return self.drive(p.sweep_speed)
 
-    def _nothing_found(self) -> None:
+    def _nothing_found(self, now: float) -> None:
         """A sweep line brought no puck: it ran its length, or what the fingertips saw could not be picked up (a
         wall, a teammate, a puck the jaw missed). Counting only the first kind, three robots seeing each other
         round the spill never widened the search, and three pucks pushed 3-4 m down the carry lane were never
@@ -431,7 +442,7 @@ class MoveSpill(SetController):
         if self.knowledge.hint is not None and self.empty_lines >= p.hint_lines:
             self.knowledge.hint, self.empty_lines = None, 0  # nothing left there: back to the spill
         elif self.empty_lines >= p.empty_lines:
-            self.knowledge.spill_empty = True
+            self.knowledge.found_empty(now)
 
     def _new_line(self) -> tuple:
         """(heading, length, None): through a random point near the search centre, and ``sweep_overshoot``
@@ -472,7 +483,7 @@ class MoveSpill(SetController):
     def _pick(self, obs: Observation) -> Command:
         command = self.step(obs)
         if self.step.status == G.FAILED:
-            self._nothing_found()
+            self._nothing_found(obs.time)
             return self._begin("recover", [G.Release(self.sensors, self.params.gripper)], obs)
         if self.step.status == G.SUCCEEDED:
             # Pucks get pushed about: look for the next one where this one was (the jaw is ahead of the pose).
@@ -566,7 +577,7 @@ class CleanupRobot:
     def __init__(self, robot: RobotModel, rng: np.random.Generator, params: CleanupParams = CleanupParams(),
                  methodical: bool = True, alliance: AllianceParams = AllianceParams(),
                  learned: TaskStatistics | None = None):
-        self.knowledge = CleanupKnowledge(params.report_interval)
+        self.knowledge = CleanupKnowledge(params.report_interval, params.empty_rest)
         self.estimate = PoseEstimate(robot.drive)
         bumpers = tuple(name for name in robot.touch if name.startswith("bump_"))
         avoid = AvoidObstacles(robot.ir_sensors, robot.ir_bearings, bumpers, rng, params.drive)
@@ -576,7 +587,7 @@ class CleanupRobot:
         sets += [(WANDER, FIND, FindWander(robot, *common), lambda obs: not k.located),
                  (REPORT, REPORT, ReportProgress(*common), lambda obs: k.report_due(obs.time)),
                  (MOVE, MOVE, MoveSpill(robot, rng, *common),
-                  lambda obs: k.located and not k.spill_empty and not k.just_delivered)]
+                  lambda obs: k.located and not k.spill_empty(obs.time) and not k.just_delivered)]
         self.sets = {name: controller for name, _, controller, _ in sets}
         definitions = [BehaviourSetDefinition(name, applicable, controller, task=task, rates=RATES[name])
                        for name, task, controller, applicable in sets]

@@ -11,7 +11,7 @@ import numpy as np
 
 from teamsim.config import TrialConfig
 from teamsim.models.arenas import Bog, Box, add_bog, walled_room
-from teamsim.models.objects import BoxDims, PuckDims, box, place, puck
+from teamsim.models.objects import BoxDims, PuckDims, box, place, place_puck
 from teamsim.tasks.base import RobotSlot, Scene
 
 
@@ -40,7 +40,7 @@ class CustomMission:
     def build(self, params: CustomParams, rng: np.random.Generator, newcomers, physics_dt: float) -> Scene:
         arena = walled_room(*params.room, obstacles=params.obstacles, physics_dt=physics_dt)
         for k, (x, y) in enumerate(params.pucks):
-            place(arena, puck(f"puck{k}", params.puck_dims), x, y, damping=params.puck_dims.roll_damping)
+            place_puck(arena, f"puck{k}", params.puck_dims, x, y)
         for k, (x, y, yaw) in enumerate(params.boxes):
             place(arena, box(f"box{k}", params.box_dims), x, y, yaw)
         for k, bog in enumerate(params.bogs):

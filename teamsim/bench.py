@@ -7,6 +7,10 @@ real-time factor of
       energy sampling and trajectory recording;
 and the ratio b/a (the share of the physics rate that survives the Python layer).
 
+cleanup: the 3-robot hazardous-waste mission's real-time factor (the issue's target: >= 20x on one core, no video),
+with resting objects asleep (as shipped, see :func:`teamsim.models.arenas.walled_room`) and with sleeping
+switched off on the same world, and the ratio of the two.
+
 render: frames/s at 640x480 for a 5-robot scene: the MuJoCo render alone, with the HUD, and with the HUD
 and H.264 encoding (the whole live video path).
 """
@@ -96,6 +100,25 @@ def robot_kinds(seconds: float = 10.0) -> list[dict]:
         print(f"{kind:>10} {bare:>17.0f} {stack:>18.0f} {stack * world.physics_dt:>6.1f}x {stack / bare:>6.2f}",
               flush=True)
     return rows
+
+
+def cleanup(seconds: float = 300.0, seed: int = 9) -> dict:
+    mission = MISSIONS["hazardous-waste"]
+
+    def real_time_factor(sleep: bool) -> float:
+        world = World(TrialConfig(mission="hazardous-waste", params=mission.Params(), seed=seed), mission)
+        if not sleep:
+            world.model.opt.enableflags &= ~int(mujoco.mjtEnableBit.mjENBL_SLEEP)
+        return stack_steps_per_second(world, seconds) * world.physics_dt
+
+    print(f"bench cleanup: hazardous-waste, 3 robots, seed {seed}, {seconds:g} s simulated, full control stack, "
+          f"no video")
+    result = {"sleep_rtf": real_time_factor(True), "awake_rtf": real_time_factor(False)}
+    result["ratio"] = result["sleep_rtf"] / result["awake_rtf"]
+    print(f"  resting objects asleep  {result['sleep_rtf']:6.1f}x real time   (target >= 20x)")
+    print(f"  every body awake        {result['awake_rtf']:6.1f}x real time")
+    print(f"  ratio                   {result['ratio']:6.2f}")
+    return result
 
 
 def render(seconds: float = 4.0, robots: int = 5, width: int = 640, height: int = 480) -> dict:

@@ -108,7 +108,7 @@ def _build_parser() -> argparse.ArgumentParser:
     faults.add_argument("--out", type=Path, default=Path("renders/study-cleanup-faults"))
 
     bench = commands.add_parser("bench", help="benchmarks")
-    bench.add_argument("what", choices=("physics", "render", "nav", "alliance", "allocate"))
+    bench.add_argument("what", choices=("physics", "cleanup", "render", "nav", "alliance", "allocate"))
     bench.add_argument("--seconds", type=float, default=None, help="simulated seconds per measurement")
     return parser
 
@@ -314,6 +314,8 @@ def cmd_bench(args) -> int:
         bench.physics(seconds=args.seconds or 10.0)
         print()
         bench.robot_kinds(seconds=args.seconds or 10.0)
+    elif args.what == "cleanup":
+        bench.cleanup(seconds=args.seconds or 300.0)
     else:
         bench.render(seconds=args.seconds or 4.0)
     return 0

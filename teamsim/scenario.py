@@ -36,7 +36,7 @@ from teamsim.config import (ConfigError, PositioningConfig, RadioConfig, Timing,
 from teamsim.faults import FAULT_KINDS, Fault, parse_fault
 from teamsim.models import ROBOT_BUILDERS, ROBOT_KINDS, build_robot
 from teamsim.models.arenas import OBSTACLE_RGBA, Bog, Box, add_bog, walled_room
-from teamsim.models.objects import BoxDims, PuckDims, box, place, puck
+from teamsim.models.objects import BoxDims, PuckDims, box, place, place_puck
 from teamsim.models.robot import TricycleSpec
 
 MAX_EXTENT = 1000.0  # m: bound on every position and size, so that a typo (or inf) is caught as out of range
@@ -505,7 +505,7 @@ def scene_of(scenario: Scenario, newcomers: list[tuple[str, str]], physics_dt: f
         add_bog(arena, bog, f"bog{k}")
     things = scenario.objects
     for k, p in enumerate(things.pucks):
-        place(arena, puck(f"puck{k}", things.puck), p.x, p.y)
+        place_puck(arena, f"puck{k}", things.puck, p.x, p.y)
     for k, b in enumerate(things.boxes):
         place(arena, box(f"box{k}", things.box), b.x, b.y, b.yaw)
     joining = {name for name, _ in newcomers}

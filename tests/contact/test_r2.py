@@ -344,6 +344,22 @@ def test_a_puck_knocked_onto_its_side_stops_rolling():
     assert abs(end[2] - PUCK.radius) < 2e-3, "still on its side"
 
 
+
+def test_the_cleanup_missions_pucks_have_the_same_rolling_resistance():
+    """The mission's world comes from its scenario, not from the contact harness: its pucks must be placed with
+    the damping too (they were not, and a puck on its side rolled on at 0.6 mm/s for 1200 s)."""
+    from teamsim.config import TrialConfig
+    from teamsim.runner import World, mission_of, resolve
+
+    mission = mission_of("hazardous-waste")
+    world = World(resolve(TrialConfig(mission="hazardous-waste", params=mission.Params(), seed=0), mission), mission)
+    pucks = [b for b in range(world.model.nbody) if world.model.body(b).name.startswith("puck") and
+             world.model.body_jntnum[b]]  # the attachment frames, which carry the free joints
+    assert len(pucks) == 10
+    for body in pucks:
+        dof = world.model.jnt_dofadr[world.model.body_jntadr[body]]
+        assert world.model.dof_damping[dof:dof + 6] == pytest.approx([PUCK.roll_damping] * 6)
+
 # -- box pushing (Parker §6.1) ------------------------------------------------------------------------------
 def box_pose(world) -> np.ndarray:
     position, rotation = frame_of(world, mujoco.mjtObj.mjOBJ_BODY, "box0/box")

@@ -33,7 +33,7 @@ def test_spill_is_the_centre_of_the_front_third_and_goal_the_back_centre(home, s
 
 def test_a_robot_learns_locations_and_reports_from_teammates_broadcasts():
     k = CleanupKnowledge(report_interval=240.0)
-    k.hear({"task": "idle", "report": 0.0, "spill_empty": False})
+    k.hear({"task": "idle", "report": 0.0, "emptied_at": None})
     assert not k.located
     k.hear({"task": "find-locations", "spill": (1, 2), "goal": (3, 4), "entrance": (0, 0),
             "extents": (-1, 5, -2, 2), "report": 0.0})
@@ -45,8 +45,17 @@ def test_a_robot_learns_locations_and_reports_from_teammates_broadcasts():
     assert k.report_due(250.0)
     k.hear({"report": 245.0})  # a teammate reported: this robot's delivery is covered
     assert not k.report_due(500.0) and k.last_report == 245.0
-    k.hear({"spill_empty": True})
-    assert k.spill_empty
+
+def test_a_spill_found_empty_by_a_teammate_is_believed_empty_until_the_rest_is_over():
+    k = CleanupKnowledge(report_interval=240.0, empty_rest=120.0)
+    assert not k.spill_empty(0.0)
+    k.hear({"emptied_at": 500.0})
+    assert k.spill_empty(500.0) and k.spill_empty(619.0)
+    assert not k.spill_empty(620.0)  # the rest is over: look again
+    k.hear({"emptied_at": 400.0})  # an older finding changes nothing
+    assert k.message()["emptied_at"] == 500.0 and not k.spill_empty(620.0)
+    k.found_empty(700.0)
+    assert k.spill_empty(700.0) and k.message()["emptied_at"] == 700.0
 
 
 def test_report_is_due_only_after_a_delivery_and_the_interval():
