@@ -52,7 +52,7 @@ def test_a_teammate_takes_over_the_search_when_red_dies(tmp_path):
     """Red dies by the north wall at 40 s, mid-search; blue or green takes the search over with find-wander,
     finds the locations round red's body and tells the team: every living robot believes a goal inside the goal
     zone and a spill within 0.5 m of the spill's centre. (Whether the two then finish the cleanup is the study's
-    business: `teamsim study cleanup-faults`, 6 of 10 at the last count, docs/hazardous-waste.md.)"""
+    business: `teamsim study cleanup-faults`, 20 of 20 on seeds 0-19, docs/hazardous-waste.md.)"""
     summary, _ = cleanup(tmp_path, 4, "kill:red@40", duration=400.0)
     metrics = summary["metrics"]
     assert summary["status"] in ("completed", "failed"), summary.get("error")
@@ -73,12 +73,12 @@ def test_a_teammate_takes_over_the_search_when_red_dies(tmp_path):
 
 
 def test_without_radio_every_robot_finds_and_reports_for_itself(tmp_path):
-    """The thesis's replication without awareness (ch.5). Whether the mission completes is the fault study's
-    measure, not this test's: seed 0 is one of the runs that does not (7 of 8 pucks by 1800 s, the last ones against
-    the walls at both ends of the room; docs/hazardous-waste.md)."""
+    """The thesis's replication without awareness (ch.5), and the mission still completes (the fault study's
+    radio-off condition: 20 of 20 on seeds 0-19, docs/hazardous-waste.md)."""
     summary, _ = cleanup(tmp_path, 0, "radio-off:red@0", "radio-off:blue@0", "radio-off:green@0")
     metrics = summary["metrics"]
-    assert summary["status"] in ("completed", "failed"), summary.get("error")
+    assert summary["status"] == "completed", summary.get("error")
+    assert metrics["pucks_at_goal"] >= 8
     assert metrics["find_locations_by"] == ["blue", "green", "red"]  # replicated: nobody heard the locations
     assert all(r["located"] for r in metrics["per_robot"].values())
     assert all(r["reports"] >= 1 and r["transports"] >= 1 for r in metrics["per_robot"].values())
@@ -88,7 +88,7 @@ def test_a_robot_with_a_broken_gripper_gives_up_move_spill(tmp_path, capsys):
     """L-ALLIANCE's failure penalty (§4.6): green's gripper breaks at 100 s; it gives move-spill up at lambda
     (2 x its 40 s prior, no floor: set short so that it shows within one mission), is charged twice the time it
     tried, and waits that long before trying again. (Whether red and blue then finish is the fault study's measure, not this
-    test's: with seed 9 they deliver 7 of the 8 pucks, the last three lying against the walls.)"""
+    test's: with seed 9 they do, 9 pucks home at 743 s.)"""
     import json
 
     from teamsim.cli import main
