@@ -1,8 +1,8 @@
 """The hazardous-waste cleanup behaviour sets of Parker's R-2s (§3.8.1, Figs 3-4 to 3-8; spec §4.1).
 
 Every robot carries :class:`CleanupKnowledge`: what it believes about the mission (its home by the entrance, the
-room's extents, the spill and goal locations, when the team last reported, when the spill was last found empty), built
-from its own sensing and from teammates' broadcasts. The behaviour sets' sensory feedback is read from it:
+room's extents, the spill and goal locations, when the team last reported, when the spill was last found
+empty), built from its own sensing and from teammates' broadcasts. The behaviour sets' sensory feedback is read from it:
 
 - find-initial-final-locations (task ``find-locations``): applicable while the locations are unknown. Two
   versions: *methodical* (Fig. 3-5, :class:`FindMethodical`) follows the walls with the side IR, keeping the
@@ -20,8 +20,9 @@ from its own sensing and from teammates' broadcasts. The behaviour sets' sensory
   by radio, which satisfies its teammates.
 
 The robot that finds the locations broadcasts them (the virtual sensor of §3.8.2), and every broadcast also
-carries the last report time and when the spill was found empty (the belief lapses after ``empty_rest``). With the radio off nothing is shared, so every capable
-robot finds the locations and reports for itself (ch.5's "no awareness").
+carries the last report time and when the spill was found empty (that belief lapses after ``empty_rest``). With
+the radio off nothing is shared, so every capable robot finds the locations and reports for itself (ch.5's "no
+awareness").
 
 The avoid-obstacles layer (:class:`teamsim.controllers.goto.AvoidObstacles`) runs under every set except while
 move-spill sweeps and picks up (Fig. 3-4). Constants the thesis does not give are in :class:`CleanupParams`.
@@ -131,7 +132,7 @@ def locations_from_extents(extents: np.ndarray, home: np.ndarray, clearance: flo
 class CleanupKnowledge:
     """One robot's beliefs about the mission, and its own tallies (transports, reports)."""
     report_interval: float
-    empty_rest: float = math.inf
+    empty_rest: float = CleanupParams.empty_rest
     home: np.ndarray | None = None
     spill: tuple | None = None
     goal: tuple | None = None
@@ -169,8 +170,9 @@ class CleanupKnowledge:
         if payload.get("report", -math.inf) > self.last_report:
             self.last_report = payload["report"]
             self.delivered_since_report = False
-        if payload.get("emptied_at") is not None:
-            self.emptied_at = max(self.emptied_at or -math.inf, payload["emptied_at"])
+        heard = payload.get("emptied_at")
+        if heard is not None and (self.emptied_at is None or heard > self.emptied_at):
+            self.emptied_at = heard
 
     def message(self) -> dict:
         """What this robot tells its teammates in every broadcast."""

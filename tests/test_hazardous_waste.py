@@ -87,8 +87,8 @@ def test_without_radio_every_robot_finds_and_reports_for_itself(tmp_path):
 def test_a_robot_with_a_broken_gripper_gives_up_move_spill(tmp_path, capsys):
     """L-ALLIANCE's failure penalty (§4.6): green's gripper breaks at 100 s; it gives move-spill up at lambda
     (2 x its 40 s prior, no floor: set short so that it shows within one mission), is charged twice the time it
-    tried, and waits that long before trying again. (Whether red and blue then finish is the fault study's measure, not this
-    test's: with seed 9 they do, 9 pucks home at 743 s.)"""
+    tried, and waits that long before trying again. (Whether red and blue then finish is the fault study's measure,
+    not this test's: with seed 9 they do, 9 pucks home at 743 s.)"""
     import json
 
     from teamsim.cli import main
