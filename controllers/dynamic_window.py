@@ -72,7 +72,9 @@ Per cycle (Fig 3.6, Fig 3.7):
   7. Selection: the best primary objective if valid (> -1); else a linear velocity opposing the current motion
      with the best secondary objective over omega; else that velocity with omega from the average curvature
      (a differential drive's: the middle of its angular window). Never towards a flagged obstacle: if that last
-     resort would be, the robot brakes as hard as it can instead (a choice; the thesis does not say).
+     resort would be, the robot brakes as hard as it can instead (a choice; the thesis does not say). A tricycle
+     at rest with no admissible candidate first turns its front wheel (``DynamicWindow._steer_at_rest``
+     [RECON]: a wheel left turned towards a close side obstacle held the robot beside it for good).
 
 Variants (§3.6.2): FRC, the full method; RFRC, DCF = 1 and no CL_ob, (3.39) and (3.40); ODW, the original window
 with no direction sensor: v_obmax = v_gmax, v_min = -v_gmax, the tricycle's curvature check like CC_D, no DCF,
@@ -100,6 +102,7 @@ import numpy as np
 
 from teamsim.controllers.astar import PlannerParams, WeightAdaptation, adapt_weights, plan_on_grid
 from teamsim.controllers.base import Command, Observation
+from teamsim.controllers.locomotion import next_steer
 from teamsim.controllers.occupancy_grid import OccupancyGrid
 from teamsim.controllers.polar_histogram import (DirectionSensorParams, modified_target_heading, target_heading,
                                                  wrap)
@@ -109,6 +112,7 @@ from teamsim.models.robot import DriveLimits
 DRIVE_FORMS = {"tricycle": "tricycle", "differential": "differential", "diffdrive": "differential",
                "tracked": "differential"}
 INVALID = -1.0  # the objectives' "otherwise" value
+STEER_REQUEST = 0.01  # rad/s: the turn-only command (0, +-this) that turns a standing tricycle's wheel
 
 
 class Method(enum.Enum):
@@ -185,7 +189,8 @@ class DriveState:
 class Decision:
     v: float
     omega: float
-    branch: str  # "primary", "secondary", "curvature" (average-curvature fallback) or "brake"
+    branch: str  # "primary", "secondary", "curvature" (average-curvature fallback), "steer" (a standing
+    # tricycle turns its wheel) or "brake"
     objective: float  # the chosen candidate's objective; -1 for the fallbacks
     v_min: float  # (3.23)'s v_min, kept for its hysteresis
 
@@ -506,6 +511,10 @@ class DynamicWindow:
         if not self.method.modified:
             return self._brake(state, v_window, (w_lo, w_hi), v_min)
 
+        if self.tricycle and state.v == 0.0:
+            steer = self._steer_at_rest(state, points, distance, heading, v_min)
+            if steer is not None:
+                return steer
         # Oppose the current motion (standing still: move away from the nearer of front and rear).
         backwards = state.v > 0 or (state.v == 0 and d_obfr <= d_obrr)
         v_oppose = v_window[0] if backwards else v_window[1]
@@ -546,7 +555,6 @@ class DynamicWindow:
         (tricycle FRC only)."""
         if not self.tricycle:
             return np.ones(v.size, bool), np.zeros(v.size, bool)  # CC_D holds by construction (module notes)
-        p = self.params
         c_min, c_max = self.curvature_limits(state.steer)
         still = np.abs(v) < 1e-9
         curvature = omega / np.where(still, 1.0, v)
@@ -556,13 +564,34 @@ class DynamicWindow:
             cc = curvature_in_range(v, omega, c_min, c_max)  # ODW, ODWDS: like CC_D
         if self.method is not Method.FRC:
             return cc, np.zeros(v.size, bool)
+        left, right = self.close_sides(points, distance)
+        steers_to_close = ~still & ((left & (curvature > 1e-9)) | (right & (curvature < -1e-9)))
+        return cc, steers_to_close
+
+    def close_sides(self, points: np.ndarray, distance: np.ndarray) -> tuple[bool, bool]:
+        """Whether a close side obstacle CL_ob lies on the left, and on the right."""
+        p = self.params
         bearing = np.arctan2(points[:, 1], points[:, 0])
         close = distance - self.radius <= p.close_side_distance
         lo, hi = p.side_sector
-        left = bool((close & (bearing >= lo) & (bearing <= hi)).any())
-        right = bool((close & (-bearing >= lo) & (-bearing <= hi)).any())
-        steers_to_close = ~still & ((left & (curvature > 1e-9)) | (right & (curvature < -1e-9)))
-        return cc, steers_to_close
+        return (bool((close & (bearing >= lo) & (bearing <= hi)).any()),
+                bool((close & (-bearing >= lo) & (-bearing <= hi)).any()))
+
+    def _steer_at_rest(self, state: DriveState, points: np.ndarray, distance: np.ndarray, heading: float,
+                       v_min: float) -> Decision | None:
+        """A tricycle at rest with no admissible candidate turns its front wheel (a turn-only command,
+        ``locomotion.next_steer``): away from a close side obstacle on one side only, else towards the target
+        heading; None once the wheel is at that lock. [RECON: the thesis does not say what a tricycle does from
+        rest when nothing is admissible.] The wedge this breaks: stopped beside an obstacle with the wheel turned
+        towards it, every forward candidate steers towards CL_ob (DCF = 0 rejects them; the secondary objective
+        then picks a creep that cannot stop), the obstacle is outside the front sector so (3.23) forbids
+        reversing, and "oppose the current motion" from rest is v = 0 or such a creep: with a wheel that does not
+        turn at v = 0 the robot stayed there, or rocked towards the obstacle a millimetre at a time, for good."""
+        left, right = self.close_sides(points, distance)
+        side = 1.0 if right and not left else -1.0 if left and not right else (1.0 if heading >= 0 else -1.0)
+        if abs(side * self.steering.steer_max - state.steer) < 1e-9:
+            return None
+        return Decision(0.0, side * STEER_REQUEST, "steer", INVALID, v_min)
 
     def _brake(self, state: DriveState, v_window, w_window, v_min: float) -> Decision:
         """The reachable velocity nearest a standstill; a tricycle keeps its steering angle."""
@@ -718,14 +747,13 @@ class DynamicWindowController:
 
     def _command(self, v: float, omega: float, behaviour: str) -> Command:
         """Issue (v, omega) and track the drive state it leads to; a tricycle's steering angle follows as the
-        tricycle locomotion turns it (towards atan(omega L / v), within its range and rate; held when v ~ 0)."""
-        steer = self.state.steer
-        if self.window.tricycle and abs(v) > 1e-3:
-            s = self.window.steering
-            wanted = float(np.clip(math.atan(omega * s.wheelbase / v), -s.steer_max, s.steer_max))
-            step = s.steer_rate_max * self.window.dt
-            steer += float(np.clip(wanted - steer, -step, step))
-        self.state = DriveState(v, omega, steer)
+        tricycle locomotion turns it (``locomotion.next_steer``); a tricycle standing still does not turn, whatever
+        its command asks of the wheel."""
+        steer, turn_rate = self.state.steer, omega
+        if self.window.tricycle:
+            steer = next_steer(steer, v, omega, (v, omega), self.window.steering, self.window.dt)
+            turn_rate = omega if v != 0.0 else 0.0
+        self.state = DriveState(v, turn_rate, steer)
         return Command(v=v, omega=omega, behaviour=behaviour)
 
 

@@ -78,10 +78,31 @@ class DifferentialDrive:
         self._correction = 0.0
 
 
+def next_steer(steer: float, v: float, omega: float, commanded: tuple[float, float], geometry, dt: float) -> float:
+    """A tricycle's front-wheel angle one control period on, at most ``steer_rate_max dt`` from ``steer`` and
+    within +-``steer_max`` (``geometry``: anything with wheelbase, steer_max and steer_rate_max). Moving (the
+    slewed speed ``v`` above 1 mm/s) the wheel turns towards atan(omega L / v), the bicycle model's angle for
+    (v, omega). Standing, it holds, unless the command (``commanded``, before slewing) is a turn alone,
+    (0, omega != 0): the robot cannot turn in place, but its steering servo can, and the wheel turns towards
+    the lock on that side, ready to move off turning that way. The navigation controllers ask for it when a
+    stop beside an obstacle has left the wheel turned towards it (Chand's Fig 3.8 wedge; see
+    ``teamsim.controllers.dynamic_window``); the thesis does not say whether its tricycle steered at rest."""
+    if abs(v) > 1e-3:
+        wanted = math.atan(omega * geometry.wheelbase / v)
+    elif commanded[0] == 0.0 and commanded[1] != 0.0:
+        wanted = math.copysign(geometry.steer_max, commanded[1])
+    else:
+        wanted = steer
+    wanted = min(max(wanted, -geometry.steer_max), geometry.steer_max)
+    step = geometry.steer_rate_max * dt
+    return steer + min(max(wanted - steer, -step), step)
+
+
 class TricycleDrive:
     """Front wheel steered to ``delta = atan(omega L / v)`` and driven at ``v / cos(delta)`` so the rear-axle
     midpoint moves at (v, omega) (bicycle model, wheelbase ``L``). The steering angle changes no faster than
-    ``steer_rate_max``, and with v = 0 the robot cannot turn: it has no point turns (Chand §3.6)."""
+    ``steer_rate_max``, and with v = 0 the robot cannot turn: it has no point turns (Chand §3.6); a turn-only
+    command turns its wheel (``next_steer``)."""
     continuous = False
 
     def __init__(self, spec, limits, control_dt: float):
@@ -92,16 +113,10 @@ class TricycleDrive:
         self.wheel_speed = 0.0
 
     def command(self, v: float, omega: float) -> None:
+        commanded = (v, omega)
         v, omega = self.slew(v, omega)
-        spec = self.spec
-        if abs(v) > 1e-3:
-            wanted = math.atan(omega * spec.wheelbase / v)
-        else:
-            wanted = self.steer  # standing still: keep the wheel where it is
-        wanted = min(max(wanted, -spec.steer_max), spec.steer_max)
-        step = spec.steer_rate_max * self.dt
-        self.steer += min(max(wanted - self.steer, -step), step)
-        self.wheel_speed = v / max(math.cos(self.steer), 0.05) / spec.wheel_radius
+        self.steer = next_steer(self.steer, v, omega, commanded, self.spec, self.dt)
+        self.wheel_speed = v / max(math.cos(self.steer), 0.05) / self.spec.wheel_radius
 
     def targets(self, time: float) -> np.ndarray:
         return np.array([self.steer, self.wheel_speed])

@@ -23,7 +23,8 @@ returns the same (v, omega) on every branch of the selection logic (Fig 3.7):
   5. the primary objective (3.35): alpha_2 h + gamma |v| / v_max if ST_v and DC_cd > DC_cdmin, alpha_3 times
      that if ST_v and DC_cd <= DC_cdmin, -1 otherwise (and -1 for inadmissible candidates); the first candidate
      with the greatest value wins if it is > -1;
-  6. otherwise the opposing linear velocity and the best secondary objective over omega, (3.36) for the
+  6. otherwise, for a tricycle at rest whose wheel is not yet at the lock it should turn to, that turn of its
+     wheel; otherwise the opposing linear velocity and the best secondary objective over omega, (3.36) for the
      tricycle, (3.37) for differential drive [RECON]: alpha_2 h DC_cd^2 / DC_cdmax^2 on their conditions;
   7. otherwise that velocity with omega from the average curvature, or the hardest braking if that would move
      the centre towards a flagged point.
@@ -35,7 +36,7 @@ from __future__ import annotations
 
 import math
 
-from teamsim.controllers.dynamic_window import DriveState, DynamicWindow, Method
+from teamsim.controllers.dynamic_window import STEER_REQUEST, DriveState, DynamicWindow, Method
 
 TWO_PI = 2 * math.pi
 
@@ -272,6 +273,12 @@ def reference_decide(window: DynamicWindow, state: DriveState, points, heading: 
     if primary[best] > -1.0:
         return candidates[best][0], candidates[best][1], "primary", v_min
 
+    # A standing tricycle turns its wheel, away from a close side obstacle on one side only, else towards the
+    # heading, until the wheel is at that lock.
+    if window.tricycle and state.v == 0.0:
+        side = 1.0 if right and not left else -1.0 if left and not right else (1.0 if heading >= 0 else -1.0)
+        if abs(side * window.steering.steer_max - state.steer) >= 1e-9:
+            return 0.0, side * STEER_REQUEST, "steer", v_min
     # Oppose the current motion (standing still: away from the nearer of front and rear).
     backwards = state.v > 0 or (state.v == 0 and d_obfr <= d_obrr)
     v_oppose = v_wmin if backwards else v_wmax

@@ -34,6 +34,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from teamsim.controllers.base import Observation
+from teamsim.controllers.locomotion import next_steer
 from teamsim.controllers.occupancy_grid import OccupancyGrid
 from teamsim.models.arenas import Box
 from teamsim.models.robot import DriveLimits
@@ -199,7 +200,7 @@ def kinematic_run(world: NavWorld, controller, robot: KinematicRobot, duration: 
                   control_dt: float = 0.1, substeps: int = 5, on_contact: str = "end") -> KinematicRun:
     """Drive ``controller`` from the world's start with ideal IR ranges and exact positioning fixes every control
     tick. The command is clipped and slewed by the drive limits as the locomotion does; a tricycle's front wheel
-    turns towards atan(omega L / v) at its steering rate and the robot then follows the bicycle model, a
+    turns as the locomotion turns it (``locomotion.next_steer``) and the robot then follows the bicycle model, a
     differential drive follows the unicycle model.
 
     ``on_contact`` says what a motion that would make the enclosing circle touch a box or wall does: "end" ends
@@ -240,10 +241,7 @@ def kinematic_run(world: NavWorld, controller, robot: KinematicRobot, duration: 
                                -lim.angular_accel_max * control_dt, lim.angular_accel_max * control_dt))
         turn_rate = omega
         if robot.kind == "tricycle":
-            wanted = math.atan(omega * robot.wheelbase / v) if abs(v) > 1e-3 else steer
-            wanted = min(max(wanted, -robot.steer_max), robot.steer_max)
-            step = robot.steer_rate_max * control_dt
-            steer += min(max(wanted - steer, -step), step)
+            steer = next_steer(steer, v, omega, (command.v, command.omega), robot, control_dt)
             turn_rate = v * math.tan(steer) / robot.wheelbase
         dt = control_dt / substeps
         nx, ny, nheading = x, y, heading

@@ -14,6 +14,7 @@ from hypothesis import strategies as st
 from teamsim.controllers.base import Observation
 from teamsim.controllers.dynamic_window import (FRC, HRDK, HRDU, ODW, ODWDS, RFRC, DriveState, DynamicWindow,
                                                 DynamicWindowParams, Method, SteeringGeometry, _PoseTracker)
+from teamsim.controllers.locomotion import next_steer
 from teamsim.models.robot import DriveLimits
 from teamsim.positioning import PoseFix
 from teamsim.tasks.nav_worlds import KinematicRobot, kinematic_run, random_world
@@ -151,6 +152,37 @@ def test_at_rest_beside_an_obstacle_inside_the_margin_a_differential_robot_turns
     assert decision.v == 0.0 and decision.omega < 0.0
 
 
+def test_a_tricycle_wedged_at_rest_turns_its_wheel_away_and_drives_off():
+    # At rest, a wall 0.15 m from the rim along its right side (outside the front sector: no reversing), the
+    # wheel left at -37 degrees towards it (every stall of the kinematic study ended so), the target a little
+    # to the right. Every forward candidate steers towards the close obstacle and DCF = 0 rejects it; the robot
+    # stood there, or crept towards the wall, for good. It must turn its wheel left, then drive off.
+    dw = tricycle()
+    xs = np.arange(-0.5, 0.51, 0.05)
+    points = np.column_stack([xs, np.full_like(xs, -0.65)])
+    state, v_min, branches = DriveState(0.0, 0.0, math.radians(-37)), 0.0, []
+    for _ in range(12):
+        decision = dw.decide(state, points, heading=-0.3, d_tgt=9.0, v_min_previous=v_min)
+        branches.append(decision.branch)
+        v_min = decision.v_min
+        steer = next_steer(state.steer, decision.v, decision.omega, (decision.v, decision.omega), dw.steering,
+                           dw.dt)
+        state = DriveState(decision.v, decision.omega if decision.v else 0.0, steer)
+        assert decision.v >= 0.0
+    first = dw.decide(DriveState(0.0, 0.0, math.radians(-37)), points, heading=-0.3, d_tgt=9.0)
+    assert first.branch == "steer" and first.v == 0.0 and first.omega > 0  # the wheel turns left, off the wall
+    assert branches[-1] == "primary" and state.v > 0.0 and state.steer > math.radians(-5)
+
+
+def test_a_tricycle_whose_wheel_is_at_the_lock_falls_back_as_before():
+    # Nothing admissible, the wheel already at the left lock it would turn to: no endless "steer".
+    dw = tricycle()
+    xs = np.arange(-0.5, 0.51, 0.05)
+    points = np.column_stack([xs, np.full_like(xs, -0.65)])
+    decision = dw.decide(DriveState(0.0, 0.0, math.radians(60)), points, heading=-0.3, d_tgt=9.0)
+    assert decision.branch != "steer"
+
+
 def test_an_arc_into_an_obstacle_inside_the_margin_is_not_collision_free():
     # Moving at 0.4 m/s the margin is 0.14 m; a point 8 cm from the rim, ahead and to the left, is flagged but off
     # the line of motion, so the margin's test lets a left turn through. DC_cd must still see it, against the
@@ -237,8 +269,10 @@ def test_tricycle_form_never_commands_a_point_turn(scene, method):
     points, v, omega, steer = random_scene(scene, 0.5)
     omega = v * math.tan(steer) / 0.5  # a state the tricycle can be in
     decision = tricycle(method).decide(DriveState(v, omega, steer), points, heading=1.0, d_tgt=5.0)
-    if abs(decision.v) < 1e-9:
+    if abs(decision.v) < 1e-9 and decision.branch != "steer":
         assert abs(decision.omega) < 1e-9
+    if decision.branch == "steer":  # a turn-only command, which turns the wheel of a tricycle at rest only
+        assert v == 0.0 and decision.v == 0.0
 
 
 # ---------------------------------------------------------------- never towards an obstacle inside the margin

@@ -77,7 +77,7 @@ def random_scene(rng: np.random.Generator):
 
 @pytest.mark.parametrize("name", sorted(ROBOTS))
 def test_reference_matches_frc_on_every_branch_in_random_scenes(name):
-    """Random scenes reach the fallbacks (secondary objective, average curvature, brake) far more often than
+    """Random scenes reach the fallbacks (secondary objective, average curvature, steer, brake) far more often than
     driving does, for both drives."""
     window = window_of(ROBOTS[name])
     rng = np.random.default_rng(7)
@@ -91,7 +91,8 @@ def test_reference_matches_frc_on_every_branch_in_random_scenes(name):
     # A differential drive never reaches the average-curvature fallback: whenever its window holds v = 0 a stop
     # or a point turn about its centre is admissible (it sweeps nothing), and otherwise the fallback's velocity,
     # the same as the secondary search's, moves its centre straight towards what made that search fail.
-    expected = {"primary", "secondary", "brake"} | ({"curvature"} if name == "tricycle" else set())
+    # A standing tricycle that can neither move on nor back away turns its wheel ("steer").
+    expected = {"primary", "secondary", "brake"} | ({"curvature", "steer"} if name == "tricycle" else set())
     assert branches == expected
 
 

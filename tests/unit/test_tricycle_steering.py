@@ -1,7 +1,7 @@
 """The tricycle locomotion's steering (teamsim.controllers.locomotion.TricycleDrive): besides the turn-rate and
 angular-acceleration limits of Table 3.4 that every drive applies to (v, omega), the front wheel turns no faster
 than the steering rate (the tricycle's dynamic constraint, §3.5) and within its range, and holds its angle while
-the robot stands still (no point turns)."""
+the robot stands still (no point turns), unless a turn-only command turns it."""
 from __future__ import annotations
 
 import math
@@ -55,14 +55,23 @@ def test_standing_still_holds_the_wheel_and_cannot_turn():
     tricycle.command(0.5, 0.5)
     held = tricycle.steer
     for _ in range(5):
-        tricycle.command(0.0, 1.0)
+        tricycle.command(0.0, 0.0)
     assert tricycle.steer == held
     assert tricycle.targets(0.0)[1] == 0.0  # the drive wheel does not turn: no point turn
 
 
-def test_drive_wheel_speed_keeps_the_rear_axle_at_v():
+def test_a_turn_only_command_turns_the_standing_wheel_towards_that_side_at_the_steering_rate():
     tricycle = drive(DriveLimits(v_max=1.0, omega_max=10.0, accel_max=100.0, angular_accel_max=100.0))
-    for _ in range(10):
-        tricycle.command(0.4, 0.4)
-    steer, wheel = tricycle.targets(0.0)
-    assert wheel * SPEC.wheel_radius * math.cos(steer) == pytest.approx(0.4)
+    tricycle.command(0.5, -0.5)  # wheel turned right
+    tricycle.command(0.0, 0.0)  # and stopped there
+    start = tricycle.steer
+    assert start < 0
+    angles = []
+    for _ in range(15):
+        tricycle.command(0.0, 0.01)  # stand, asking to turn left
+        angles.append(tricycle.steer)
+        assert tricycle.targets(0.0)[1] == 0.0  # the robot stays put
+    steps = np.diff([start] + angles)
+    assert np.all(steps >= 0) and np.all(steps <= SPEC.steer_rate_max * DT + 1e-12)
+    assert steps[0] == pytest.approx(SPEC.steer_rate_max * DT)
+    assert angles[-1] == pytest.approx(SPEC.steer_max)  # to the left lock, and no further
