@@ -194,14 +194,13 @@ CAUSES = {
             "candidate of FRC by 0.01, which changes FRC's choices only against candidates that keep DC_cdmin "
             "clear; where those are rare, FRC creeps and RFRC does not.",
     "success": "FRC is purely reactive and sees obstacles in only 10-14 directions. Failures are either stalls "
-               "or wandering in the local minima of pure reactive control (rocking to and fro at a gap narrower "
-               "than its safety margin allows, looping in pockets). Robot A's stalls have one cause, traced in "
-               "the kinematic trials: a tricycle's front wheel does not steer at rest (its angle follows "
-               "atan(omega L / v), held at v ~ 0); stopped beside an obstacle with the wheel turned towards it, "
-               "DCF = 0 rejects every forward candidate, the obstacle lies outside the +-50 deg front sector so "
-               "(3.23) does not allow reversing, and 'oppose the current motion' from rest is v = 0, so it stays. "
-               "The thesis's simulator and its obstacles' sizes are not described well enough to say how it "
-               "avoided this.",
+               "or wandering in the local minima of pure reactive control: looping or rocking to and fro at a gap "
+               "narrower than the robot's circle enlarged by its safety margin (boxes keep only 0.7 m apart, "
+               "Robot B's diameter, while the enlarged circles are 0.9 m across for B, 1.2 m for A and 1.54 m for "
+               "C), and looping in pockets. Robot A's stalls at rest (stopped beside an obstacle with its front "
+               "wheel turned towards it, DCF = 0 rejecting every forward candidate, no reversing allowed) are gone "
+               "since a standing tricycle turns its wheel. The thesis does not give its obstacles' sizes or "
+               "spacing, so how often its worlds had such gaps is not known.",
 }
 
 
