@@ -389,44 +389,48 @@ class DynamicWindow:
         distance = np.hypot(points[:, 0], points[:, 1])
         pts = points[distance >= self.radius]
         clear = np.ones(v.size, bool)
-        if pts.shape[0] == 0:
+        if pts.shape[0] == 0 or v.size == 0:
             return clear
         radii = np.where(distance[distance >= self.radius] >= r, r, self.radius)
         speed, w = np.abs(v), omega.copy()
         brake = min(p.a_a, lim.accel_max)
         # Only points the enlarged circle can reach: the centre moves at most the reference point's stopping
-        # path plus the offset swung round.
+        # path plus twice the offset (the centre swung round to the reference point's other side).
         path = speed.max() * self.dt + speed.max() ** 2 / (2 * brake) + 0.1
-        reach = np.hypot(pts[:, 0], pts[:, 1]) < r + path + 2 * np.pi * abs(self.offset)
+        reach = np.hypot(pts[:, 0], pts[:, 1]) < r + path + 2 * abs(self.offset)
         pts, radii = pts[reach], radii[reach]
         if pts.shape[0] == 0:
             return clear
         moving = speed > 1e-9
         curvature = np.where(moving, omega / np.where(moving, v, 1.0), 0.0)
         direction = np.sign(v)
-        x, y, th = np.zeros(v.size), np.zeros(v.size), np.zeros(v.size)
-        # The held cycle, then braking two cycles a step (the circle's positions stay a few centimetres apart,
-        # which cannot miss a point at these radii), moving at each step's mean speed and turn rate.
-        held, dt = True, self.dt
+        # Speed and turn rate at each step's end: the held cycle, then braking two cycles a step until every
+        # candidate has stopped (the turn rate of a slower one keeps settling meanwhile). The circle's positions
+        # stay a few centimetres apart, which cannot miss a point at these radii.
+        speeds, rates = [speed, speed], [w, w]
+        turn = lim.angular_accel_max * 2 * self.dt
         while True:
-            if held:
-                next_speed, next_w = speed, w
-            else:
-                next_speed = np.maximum(speed - brake * dt, 0.0)
-                turn = lim.angular_accel_max * dt
-                next_w = np.clip(curvature * direction * next_speed, w - turn, w + turn)
-            step = direction * (speed + next_speed) / 2 * dt
-            mean_w = (w + next_w) / 2
-            mid = th + mean_w * dt / 2
-            x, y, th = x + step * np.cos(mid), y + step * np.sin(mid), th + mean_w * dt
-            # The centre, ``offset`` ahead of the reference point, relative to where the centre started.
-            cx, cy = x + self.offset * (np.cos(th) - 1.0), y + self.offset * np.sin(th)
-            d2 = (pts[:, 0][None, :] - cx[:, None]) ** 2 + (pts[:, 1][None, :] - cy[:, None]) ** 2
-            clear &= (d2 >= radii[None, :] ** 2).all(axis=1)
-            speed, w = next_speed, next_w
-            if not held and not speed.any():
-                return clear
-            held, dt = False, 2 * self.dt
+            speed = np.maximum(speed - brake * 2 * self.dt, 0.0)
+            w = np.clip(curvature * direction * speed, w - turn, w + turn)
+            speeds.append(speed)
+            rates.append(w)
+            if not speed.any():
+                break
+        speeds, rates = np.array(speeds), np.array(rates)  # (steps + 1, candidates)
+        dt = np.full((len(speeds) - 1, 1), 2 * self.dt)
+        dt[0] = self.dt
+        # Every step at once, each at its mean speed and turn rate (running sums, as stepping one by one).
+        step = direction * (speeds[:-1] + speeds[1:]) / 2 * dt
+        mean_w = (rates[:-1] + rates[1:]) / 2
+        th = np.cumsum(mean_w * dt, axis=0)
+        mid = np.vstack([np.zeros((1, v.size)), th[:-1]]) + mean_w * dt / 2
+        x, y = np.cumsum(step * np.cos(mid), axis=0), np.cumsum(step * np.sin(mid), axis=0)
+        # The centre, ``offset`` ahead of the reference point, relative to where the centre started.
+        centres = np.stack([x + self.offset * (np.cos(th) - 1.0), y + self.offset * np.sin(th)], axis=-1)
+        # |p - c|^2 < r^2 as c.p - |c|^2/2 > (|p|^2 - r^2)/2: one matrix product over every step, candidate and
+        # point.
+        reach = centres @ pts.T - (centres ** 2).sum(axis=-1, keepdims=True) / 2
+        return ~(reach > ((pts ** 2).sum(axis=1) - radii ** 2) / 2).any(axis=(0, 2))
 
     def towards(self, v: np.ndarray, omega: np.ndarray, points: np.ndarray) -> np.ndarray:
         """For each candidate, whether the centre moves towards any of ``points``: one of them lies ahead along the
@@ -740,7 +744,10 @@ class DynamicWindowController:
             self.memory.popleft()
         world = np.concatenate([pts for _, pts in self.memory])
         # A slow robot sees the same spots again and again: keep one point per 2 cm cell.
-        _, first = np.unique(np.round(world / 0.02).astype(np.int64), axis=0, return_index=True)
+        # (One integer key per cell, ordered as the cells' (x, y) pairs are: np.unique on rows is far slower.)
+        cell = np.round(world / 0.02).astype(np.int64)
+        cell -= cell.min(axis=0, initial=0)
+        _, first = np.unique(cell[:, 0] * (cell[:, 1].max(initial=0) + 1) + cell[:, 1], return_index=True)
         world = world[first]
         dx, dy = world[:, 0] - ox, world[:, 1] - oy
         return np.column_stack([c * dx + s * dy - self.offset, -s * dx + c * dy])

@@ -293,6 +293,8 @@ def test_never_moves_towards_an_obstacle_within_the_safety_margin(scene, kind, h
     if decision.branch == "brake":
         window = dw.linear_window(v, -0.5, 0.5)
         assert abs(decision.v) == pytest.approx(abs(float(np.clip(0.0, *window))))  # as hard as it can
+    elif decision.branch == "steer":  # a tricycle at rest turning its front wheel: nothing moves
+        assert v == 0.0 and decision.v == 0.0
     else:
         assert not dw.towards(chosen_v, chosen_w, flagged)[0]
     if decision.branch == "primary":
