@@ -387,20 +387,20 @@ class DynamicWindow:
         p, lim = self.params, self.limits
         r = self.radius + margin
         distance = np.hypot(points[:, 0], points[:, 1])
-        pts = points[distance >= self.radius]
-        clear = np.ones(v.size, bool)
+        outside = distance >= self.radius
+        pts, distance = points[outside], distance[outside]
         if pts.shape[0] == 0 or v.size == 0:
-            return clear
-        radii = np.where(distance[distance >= self.radius] >= r, r, self.radius)
-        speed, w = np.abs(v), omega.copy()
+            return np.ones(v.size, bool)
+        radii = np.where(distance >= r, r, self.radius)
+        speed, w = np.abs(v), omega
         brake = min(p.a_a, lim.accel_max)
         # Only points the enlarged circle can reach: the centre moves at most the reference point's stopping
         # path plus twice the offset (the centre swung round to the reference point's other side).
         path = speed.max() * self.dt + speed.max() ** 2 / (2 * brake) + 0.1
-        reach = np.hypot(pts[:, 0], pts[:, 1]) < r + path + 2 * abs(self.offset)
-        pts, radii = pts[reach], radii[reach]
+        reachable = distance < r + path + 2 * abs(self.offset)
+        pts, radii = pts[reachable], radii[reachable]
         if pts.shape[0] == 0:
-            return clear
+            return np.ones(v.size, bool)
         moving = speed > 1e-9
         curvature = np.where(moving, omega / np.where(moving, v, 1.0), 0.0)
         direction = np.sign(v)
@@ -411,7 +411,7 @@ class DynamicWindow:
         turn = lim.angular_accel_max * 2 * self.dt
         while True:
             speed = np.maximum(speed - brake * 2 * self.dt, 0.0)
-            w = np.clip(curvature * direction * speed, w - turn, w + turn)
+            w = np.minimum(np.maximum(curvature * direction * speed, w - turn), w + turn)  # np.clip, faster
             speeds.append(speed)
             rates.append(w)
             if not speed.any():
@@ -429,8 +429,8 @@ class DynamicWindow:
         centres = np.stack([x + self.offset * (np.cos(th) - 1.0), y + self.offset * np.sin(th)], axis=-1)
         # |p - c|^2 < r^2 as c.p - |c|^2/2 > (|p|^2 - r^2)/2: one matrix product over every step, candidate and
         # point.
-        reach = centres @ pts.T - (centres ** 2).sum(axis=-1, keepdims=True) / 2
-        return ~(reach > ((pts ** 2).sum(axis=1) - radii ** 2) / 2).any(axis=(0, 2))
+        closeness = centres @ pts.T - (centres ** 2).sum(axis=-1, keepdims=True) / 2
+        return ~(closeness > ((pts ** 2).sum(axis=1) - radii ** 2) / 2).any(axis=(0, 2))
 
     def towards(self, v: np.ndarray, omega: np.ndarray, points: np.ndarray) -> np.ndarray:
         """For each candidate, whether the centre moves towards any of ``points``: one of them lies ahead along the

@@ -41,7 +41,7 @@ import numpy as np
 
 from teamsim.controllers.astar import modified_astar
 from teamsim.controllers.base import Observation
-from teamsim.controllers.locomotion import next_steer
+from teamsim.controllers.locomotion import SlewLimiter, next_steer
 from teamsim.controllers.occupancy_grid import OccupancyGrid
 from teamsim.models.arenas import Box
 from teamsim.models.robot import DriveLimits
@@ -100,8 +100,8 @@ def random_world(density: float, rng: np.random.Generator, params: NavWorldParam
         layout = _layout(density, rng, params, (start, goal))
         if layout is None:
             continue
-        world = NavWorld(layout[0], layout[1], origin, params.resolution, params.size,
-                         (start[0], start[1], heading), goal)
+        boxes, occupancy = layout
+        world = NavWorld(boxes, occupancy, origin, params.resolution, params.size, (start[0], start[1], heading), goal)
         if has_passage(world, params.passage_radius):
             return world
     raise RuntimeError(f"could not reach {density:.0%} obstacle density with a passage for a "
@@ -169,7 +169,12 @@ def has_passage(world: NavWorld, radius: float) -> bool:
     A* on the occupancy raster bordered by the walls, occupied cells inflated by the radius and one cell more
     (a box's edge can lie up to a cell beyond the centres of the cells it covers)."""
     walled = np.pad(world.occupancy, 1, constant_values=True)
-    cell = lambda xy: tuple(int((xy[axis] - world.origin[axis]) / world.resolution) + 1 for axis in (1, 0))
+    grid = world.known_map()
+
+    def cell(xy):  # in the walled raster, one cell in from the unwalled one
+        row, col = grid.world_to_cell(xy[0], xy[1])
+        return int(row) + 1, int(col) + 1
+
     return modified_astar(walled.astype(float), cell(world.start), cell(world.goal),
                           inflation_cells=radius / world.resolution + 1).reached
 
@@ -240,9 +245,9 @@ def kinematic_run(world: NavWorld, controller, robot: KinematicRobot, duration: 
     bumper stops a real robot and a touch stops (but does not end) a physics run."""
     if on_contact not in ("end", "stop"):
         raise ValueError(f"on_contact={on_contact!r}: allowed: end, stop")
-    lim = robot.limits
+    slew = SlewLimiter(robot.limits, control_dt)
     x, y, heading = world.start
-    v = omega = steer = 0.0
+    steer = 0.0
     bearings = 2 * np.pi * np.arange(robot.ir_count) / robot.ir_count
     sensor_radius = np.asarray(robot.sensor_radius or (robot.radius,) * robot.ir_count, float)
     decision_times = []
@@ -267,10 +272,7 @@ def kinematic_run(world: NavWorld, controller, robot: KinematicRobot, duration: 
         decision_times.append(time_module.perf_counter() - began)
         if command.behaviour == "arrived":
             return run(True, False, time_now)
-        v += float(np.clip(np.clip(command.v, -lim.v_max, lim.v_max) - v, -lim.accel_max * control_dt,
-                           lim.accel_max * control_dt))
-        omega += float(np.clip(np.clip(command.omega, -lim.omega_max, lim.omega_max) - omega,
-                               -lim.angular_accel_max * control_dt, lim.angular_accel_max * control_dt))
+        v, omega = slew(command.v, command.omega)
         turn_rate = omega
         if robot.kind == "tricycle":
             steer = next_steer(steer, v, omega, (command.v, command.omega), robot, control_dt)
@@ -286,7 +288,7 @@ def kinematic_run(world: NavWorld, controller, robot: KinematicRobot, duration: 
         gap = clearance(world, cx, cy) - robot.radius
         if gap < 0 and on_contact == "stop":
             touches += 1
-            v = omega = 0.0
+            slew.reset()
             continue
         travelled += math.hypot(nx - x, ny - y)
         x, y, heading = nx, ny, nheading
