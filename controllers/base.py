@@ -24,6 +24,7 @@ class Observation:
     inbox: tuple = ()  # radio messages received since the last tick
     robots_present: frozenset = frozenset()
     motor_speeds: np.ndarray = field(default_factory=lambda: np.zeros(0))  # locomotion encoders, rad/s
+    velocity: tuple[float, float] | None = None  # odometry: (forward speed m/s, turn rate rad/s) of the chassis
     touch: dict = field(default_factory=dict)  # touch sensor -> summed contact normal force, N (bumpers, fingers)
     break_beams: np.ndarray = field(default_factory=lambda: np.zeros(0, bool))  # True where a beam is broken
     inclination: tuple | None = None  # (roll, pitch) in rad, for robots with an inclinometer

@@ -84,7 +84,15 @@ beta_1 = 0.005. (3.18) is not used by ODW, so v_max = v_glmax there: it still st
 Controllers: ``FRC``, ``RFRC``, ``ODW``, ``ODWDS`` drive straight for the goal; ``HRDK`` plans once with the
 modified A* on a known map and follows the path with FRC; ``HRDU`` maps with an occupancy grid while driving and
 re-plans. Each is ``__call__(Observation) -> Command``. Between positioning fixes (0.6 s apart) a controller
-advances its last fix by the velocities it commanded. The IR ring sees only a few directions (10-14 beams for
+advances its last fix by its odometry (``Observation.velocity``; without one, by the velocities it commanded).
+It takes the dynamic window's state (v_c, omega_c) from its own last command, which the locomotion follows under
+the same acceleration limits, except when the odometry says the robot has stalled: driven at 0.05 m/s or more,
+it moved at under a quarter of that over the last period. Something the IR ring does not see, such as a box
+corner between two beams, is holding it. The controller then starts from the measured (rest) state and
+remembers a contact point on its circle where its centre was heading (``_contact``). Before this, a robot halted
+against such a corner went on asking for the same motion for the rest of the trial (a touch-lock). The 0.05 m/s
+and the quarter are choices, not the thesis's: setting off from rest, a physics robot lags its first commands by
+more than a quarter. The IR ring sees only a few directions (10-14 beams for
 41 candidate directions), so a controller keeps the obstacle points of the last ``obstacle_memory`` seconds, in
 its odometry frame so that a fix's jump does not smear them. Eight seconds (a choice): a box corner that juts
 out between two beams is seen only from further off, and in the kinematic study Robot B met such corners about
@@ -179,7 +187,7 @@ class SteeringGeometry:
 class DriveState:
     """What the window starts from: the current velocities (v_c, omega_c) and, for a tricycle, the steering
     angle. The controllers take them from their own previous command, which the locomotion follows under the same
-    acceleration limits."""
+    acceleration limits, or from the odometry after a stall (module notes)."""
     v: float = 0.0
     omega: float = 0.0
     steer: float = 0.0
@@ -640,6 +648,9 @@ def _advance(pose: tuple[float, float, float], v: float, omega: float, dt: float
             float(wrap(th_new)))
 
 
+NO_CONTACT = np.zeros((0, 2))
+
+
 class _PoseTracker:
     """Odometry from the controller's own commands, and the pose estimate: the last fix advanced by odometry."""
 
@@ -704,8 +715,12 @@ class DynamicWindowController:
         return self.method.value
 
     def __call__(self, obs: Observation) -> Command:
-        pose = self.tracker.update(obs.time, obs.pose, self.state.v, self.state.omega)
-        points = self._remember(obs)
+        contact = self._contact(self.state, obs.velocity)
+        if len(contact):
+            self.state = DriveState(obs.velocity[0], obs.velocity[1], self.state.steer)
+        v, omega = (self.state.v, self.state.omega) if obs.velocity is None else obs.velocity
+        pose = self.tracker.update(obs.time, obs.pose, v, omega)
+        points = self._remember(obs, contact)
         if pose is None:
             return self._command(0.0, 0.0, "no fix")
         centre = (pose[0] + self.offset * math.cos(pose[2]), pose[1] + self.offset * math.sin(pose[2]))
@@ -728,14 +743,25 @@ class DynamicWindowController:
         """The point the direction sensor aims at: the goal itself for the reactive controllers."""
         return self.goal
 
-    def _remember(self, obs: Observation) -> np.ndarray:
-        """This reading's obstacle points added to the memory; all remembered points relative to the centre,
-        in the robot frame."""
+    def _contact(self, commanded: DriveState, velocity) -> np.ndarray:
+        """Where a stall says the body touches, relative to the pose's reference point in the robot frame: the
+        point of the enclosing circle the centre was moving towards, when the odometry shows the robot stopped
+        although it was driven (a touch the IR ring did not see, such as a box corner between two beams).
+        Empty when there is no stall."""
+        if velocity is None or abs(commanded.v) < 0.05 or abs(velocity[0]) > 0.25 * abs(commanded.v):
+            return NO_CONTACT
+        bearing = math.atan2(commanded.omega * self.offset, commanded.v)
+        return np.array([[self.offset + self.radius * math.cos(bearing), self.radius * math.sin(bearing)]])
+
+    def _remember(self, obs: Observation, contact: np.ndarray = NO_CONTACT) -> np.ndarray:
+        """This reading's obstacle points, and any stall ``contact``, added to the memory; all remembered points
+        relative to the centre, in the robot frame."""
         ranges = np.asarray(obs.ir_range, float)
         bearings = np.asarray(obs.ir_bearings, float)
         seen = np.isfinite(ranges)
         reach = np.broadcast_to(self.sensor_radius, ranges.shape)[seen] + ranges[seen]
         body = np.column_stack([self.offset + reach * np.cos(bearings[seen]), reach * np.sin(bearings[seen])])
+        body = np.concatenate([body, contact])
         ox, oy, oth = self.tracker.odometry
         c, s = math.cos(oth), math.sin(oth)
         self.memory.append((obs.time, np.column_stack([ox + c * body[:, 0] - s * body[:, 1],

@@ -242,7 +242,8 @@ def kinematic_run(world: NavWorld, controller, robot: KinematicRobot, duration: 
 
     ``on_contact`` says what a motion that would make the enclosing circle touch a box or wall does: "end" ends
     the run there as a collision; "stop" refuses that tick's motion and halts the robot (v = omega = 0), the way a
-    bumper stops a real robot and a touch stops (but does not end) a physics run."""
+    bumper stops a real robot and a touch stops (but does not end) a physics run. Each observation carries the
+    odometry of the last tick's motion (``Observation.velocity``): zero after a halt."""
     if on_contact not in ("end", "stop"):
         raise ValueError(f"on_contact={on_contact!r}: allowed: end, stop")
     slew = SlewLimiter(robot.limits, control_dt)
@@ -253,6 +254,7 @@ def kinematic_run(world: NavWorld, controller, robot: KinematicRobot, duration: 
     decision_times = []
     min_clearance = math.inf
     travelled, touches = 0.0, 0
+    velocity = (0.0, 0.0)
     steps = round(duration / control_dt)
 
     def run(reached: bool, collided: bool, time_end: float) -> KinematicRun:
@@ -266,7 +268,7 @@ def kinematic_run(world: NavWorld, controller, robot: KinematicRobot, duration: 
         ranges = ray_ranges(world, np.array([cx, cy]) + sensor_radius[:, None] * directions, directions,
                             robot.ir_range)
         observation = Observation(time=time_now, robot="kinematic", ir_raw=ranges, ir_range=ranges,
-                                  ir_bearings=bearings, pose=PoseFix(x, y, heading, time_now))
+                                  ir_bearings=bearings, pose=PoseFix(x, y, heading, time_now), velocity=velocity)
         began = time_module.perf_counter()
         command = controller(observation)
         decision_times.append(time_module.perf_counter() - began)
@@ -289,9 +291,11 @@ def kinematic_run(world: NavWorld, controller, robot: KinematicRobot, duration: 
         if gap < 0 and on_contact == "stop":
             touches += 1
             slew.reset()
+            velocity = (0.0, 0.0)
             continue
         travelled += math.hypot(nx - x, ny - y)
         x, y, heading = nx, ny, nheading
+        velocity = (v, turn_rate)
         min_clearance = min(min_clearance, gap)
         if gap < 0:
             return run(False, True, time_now + control_dt)

@@ -194,14 +194,13 @@ CAUSES = {
             "candidate of FRC by 0.01, which changes FRC's choices only against candidates that keep DC_cdmin "
             "clear; where those are rare, FRC creeps and RFRC does not. With 10 trials a cell, one failed trial "
             "moves a cell's OS ratio by about 0.1, past this check's tolerance, without being significant.",
-    "success": "FRC is purely reactive and sees obstacles in only 10-14 directions. Its failures are touch-locks "
-               "and wandering. In a touch-lock the robot's circle has touched an obstacle (often a box corner "
-               "between its beams); the contact halts it, but the controller, which takes its drive state from "
-               "its own commands, goes on asking for the same motion (results.csv counts the refused ticks as "
-               "touches). Wandering is looping in a pocket of merged boxes, or at a gap that "
-               "admits the robot's body but not its circle enlarged by the safety margin (1.2 m across for A, "
-               "1.54 m for C; boxes that do not overlap keep 1.34 m apart). With 10 trials a cell, one failure "
-               "costs 10 points of SR.",
+    "success": "FRC is purely reactive and sees obstacles in only 10-14 directions. Its failures are "
+               "wandering and stalls: looping or rocking to and fro in a pocket of merged boxes, or at a gap "
+               "that admits the robot's body but not its circle enlarged by the safety margin (1.2 m across "
+               "for A, 1.54 m for C; boxes that do not overlap keep 1.34 m apart), where the direction sensor "
+               "keeps choosing the gap. (Touch-locks, halted against a box corner between the beams and asking "
+               "for the same motion for good, ended when the controllers began to detect stalls by odometry.) "
+               "With 10 trials a cell, one failure costs 10 points of SR.",
 }
 
 

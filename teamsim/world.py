@@ -25,7 +25,7 @@ from teamsim.controllers.locomotion import make_locomotion
 from teamsim.faults import Fault, Health, apply_fault
 from teamsim.models import ROBOT_BUILDERS, build_robot
 from teamsim.models.robot import RobotModel
-from teamsim.positioning import PositioningService
+from teamsim.positioning import PositioningService, wrap_angle
 from teamsim.radio import RadioBus
 from teamsim.rng import RandomStreams
 
@@ -55,6 +55,7 @@ class Robot:
     behaviour: str = "idle"
     parker_energy: float = 0.0  # Parker's count (ch.5): 1 unit per second while any motor is in use
     effector_positions: dict = field(default_factory=dict)  # encoder readings at the last tick
+    odometry_at: tuple | None = None  # (time, pose) at the last tick, whence the odometry's displacement
     behaviour_time: dict = field(default_factory=dict)
     # model indices, filled by World
     qpos_adr: int = 0
@@ -289,7 +290,7 @@ class World:
             ir_bearings=spec.ir_bearings, pose=self.positioning.fix(robot.name),
             inbox=tuple(self.radio.take_inbox(robot.name)),
             robots_present=self.radio.robots_present(robot.name, now),
-            motor_speeds=d.qvel[robot.motor_dofs], touch=touch,
+            motor_speeds=d.qvel[robot.motor_dofs], velocity=self.velocity(robot, now), touch=touch,
             break_beams=(beams >= 0) & (beams < spec.beam_length),
             inclination=self.inclination(robot) if spec.inclinometer else None,
             effectors={name: self._effector_position(robot, name) for name in robot.effectors})
@@ -332,6 +333,21 @@ class World:
         effector = robot.model.effectors[name]
         q = self.data.qpos[robot.effectors[name][1]]
         return float((q - effector.ctrl_at_0) / (effector.ctrl_at_1 - effector.ctrl_at_0))
+
+    def velocity(self, robot: Robot, now: float) -> tuple[float, float]:
+        """What the chassis's odometry reads at a control tick: (forward speed, m/s; turn rate, rad/s) over the
+        period since the last tick, from the displacement, as encoder counts over a period give it (a sampled
+        instantaneous velocity would carry the chassis's contact chatter). A blocked robot reads about zero
+        whatever its wheels are asked to do."""
+        pose = self.pose(robot)
+        last, robot.odometry_at = robot.odometry_at, (now, pose)
+        if last is None or now <= last[0]:
+            return 0.0, 0.0
+        dt = now - last[0]
+        dx, dy = pose[:2] - last[1][:2]
+        turn = wrap_angle(pose[2] - last[1][2])
+        middle = last[1][2] + turn / 2
+        return float((dx * math.cos(middle) + dy * math.sin(middle)) / dt), float(turn / dt)
 
     def yaw_rate(self, robot: Robot) -> float:
         """What a gyro on the chassis reads about its vertical axis, rad/s (free-joint angular velocity is in
@@ -406,6 +422,7 @@ class World:
         q[robot.qpos_adr:robot.qpos_adr + 7] = [x, y, 0.002, math.cos(yaw / 2), 0, 0, math.sin(yaw / 2)]
         self.data.qvel[robot.qvel_adr:robot.qvel_adr + 6] = 0
         robot.dormant = False
+        robot.odometry_at = None
         mujoco.mj_forward(self.model, self.data)
 
     # -- physics --------------------------------------------------------------------------------------------

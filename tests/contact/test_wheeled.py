@@ -76,6 +76,24 @@ def test_stops_within_its_deceleration_distance(kind):
 
 
 @pytest.mark.parametrize("kind", WHEELED)
+def test_odometry_reads_the_motion_and_zero_against_a_wall(kind):
+    """Observation.velocity: (forward speed, turn rate) over the last control period. Driving freely it reads
+    the commanded motion; pushed against a wall, the wheels still driven, it reads (about) zero: what the
+    navigation controllers' stall detection relies on."""
+    v, omega = 0.3, 0.15
+    world, red = solo(kind, lambda o: (v, omega), x=0.0, y=-2.0)
+    run_for(world, 8.0)  # past the acceleration ramp
+    speed, turn = np.mean([o.velocity for o in world.controllers["red"].observations[-20:]], axis=0)
+    assert speed == pytest.approx(v, rel=0.05)
+    assert turn == pytest.approx(omega, rel=0.05)
+    world, red = solo(kind, lambda o: (0.3, 0.0), room=(4.0, 4.0), x=0.0)
+    run_for(world, 15.0)  # the wall, 2 m ahead, is reached in about 8 s
+    assert world.pose(red)[0] > 1.0
+    speed, turn = np.mean([o.velocity for o in world.controllers["red"].observations[-20:]], axis=0)
+    assert abs(speed) < 0.02 and abs(turn) < 0.05
+
+
+@pytest.mark.parametrize("kind", WHEELED)
 def test_idle_is_stable(kind):
     world, red = solo(kind, lambda o: (0.0, 0.0))
     run_for(world, 0.5)  # settle onto the floor

@@ -370,11 +370,12 @@ def test_unknown_kind_is_refused():
 # ---------------------------------------------------------------- controllers
 
 
-def observation(time, pose=(0.0, 0.0, 0.0), ranges=None, bearings=None, fix_time=None):
+def observation(time, pose=(0.0, 0.0, 0.0), ranges=None, bearings=None, fix_time=None, velocity=None):
     bearings = np.zeros(0) if bearings is None else np.asarray(bearings, float)
     ranges = np.full(len(bearings), np.inf) if ranges is None else np.asarray(ranges, float)
     fix = None if pose is None else PoseFix(*pose, time if fix_time is None else fix_time)
-    return Observation(time=time, robot="r", ir_raw=ranges, ir_range=ranges, ir_bearings=bearings, pose=fix)
+    return Observation(time=time, robot="r", ir_raw=ranges, ir_range=ranges, ir_bearings=bearings, pose=fix,
+                       velocity=velocity)
 
 
 def test_controller_waits_for_a_fix_and_stops_at_the_goal():
@@ -396,6 +397,34 @@ def test_pose_tracker_advances_the_last_fix_by_the_commands():
     assert tracker.update(1.1, PoseFix(1.4, 2.0, 0.0, 1.1), 0.5, 0.0) == pytest.approx((1.4, 2.0, 0.0))
     x, y, heading = tracker.update(1.1 + math.pi, PoseFix(1.4, 2.0, 0.0, 1.1), 0.5, 1.0)
     assert (x, y, heading) == pytest.approx((1.4, 3.0, -math.pi))  # half a circle of radius 0.5
+
+
+def test_a_stall_is_a_contact_on_the_circle_where_the_centre_was_heading():
+    controller = FRC(LIMITS, "tricycle", 0.5, goal=(5.0, 0.0), centre_offset=0.25)
+    driven = DriveState(0.4, 0.2, 0.2)
+    # The centre, 0.25 m ahead of the rear axle, moves at (v, omega * 0.25) in the robot frame.
+    bearing = math.atan2(0.2 * 0.25, 0.4)
+    np.testing.assert_allclose(controller._contact(driven, (0.0, 0.0)),
+                               [[0.25 + 0.5 * math.cos(bearing), 0.5 * math.sin(bearing)]])
+    backing = DriveState(-0.4, 0.0, 0.0)
+    np.testing.assert_allclose(controller._contact(backing, (0.05, 0.0)), [[0.25 - 0.5, 0.0]], atol=1e-12)
+    assert len(controller._contact(driven, (0.3, 0.1))) == 0  # moving: no stall
+    assert len(controller._contact(DriveState(0.02, 0.0), (0.0, 0.0))) == 0  # setting off from rest lags
+    assert len(controller._contact(driven, None)) == 0  # no odometry, no stall
+
+
+def test_a_stalled_robot_starts_again_from_rest_and_not_into_what_stopped_it():
+    """Halted against a box corner no beam sees: the odometry reads zero. The controller takes its state from
+    the odometry (not from its own command, which it would keep repeating) and remembers the contact ahead."""
+    controller = FRC(LIMITS, "diffdrive", 0.35, goal=(5.0, 0.0))
+    velocity, time = (0.0, 0.0), 0.0
+    while velocity[0] < 0.2:  # drive off freely, the odometry reading what was commanded
+        command = controller(observation(time, pose=(0.0, 0.0, 0.0), velocity=velocity))
+        velocity, time = (command.v, command.omega), time + 0.1
+    command = controller(observation(time, pose=(0.0, 0.0, 0.0), velocity=(0.0, 0.0)))
+    assert command.v <= 0.0
+    free = FRC(LIMITS, "diffdrive", 0.35, goal=(5.0, 0.0))
+    assert free(observation(0.0, velocity=(0.0, 0.0))).v > 0.0  # the same robot at rest with nothing ahead
 
 
 def test_obstacle_points_are_remembered_for_a_while():

@@ -201,6 +201,28 @@ def test_kinematic_run_that_stops_on_contact_halts_at_the_wall_and_counts_the_to
     assert clearance(w, x, y) - 0.35 == pytest.approx(run.min_clearance)
 
 
+class Recording(Constant):
+    """Drives at a constant command and keeps the odometry each observation carries."""
+    def __init__(self, v, omega):
+        super().__init__(v, omega)
+        self.velocities = []
+
+    def __call__(self, observation):
+        self.velocities.append(observation.velocity)
+        return super().__call__(observation)
+
+
+def test_kinematic_odometry_reads_the_motion_of_the_last_tick_and_zero_once_halted():
+    robot = KinematicRobot("diffdrive", LIMITS, radius=0.35, ir_count=10)
+    driver = Recording(0.5, 0.1)
+    run = kinematic_run(empty_world(), driver, robot, duration=60.0, on_contact="stop")
+    assert driver.velocities[0] == (0.0, 0.0)
+    # Slewed at 0.1 m/s^2 and 0.15 rad/s^2 over 0.1 s ticks: the first tick moved at (0.01, 0.015).
+    assert driver.velocities[1] == pytest.approx((0.01, 0.015))
+    assert driver.velocities[20] == pytest.approx((0.2, 0.1))
+    assert run.touches > 0 and driver.velocities[-1] == (0.0, 0.0)  # halted at a wall: the robot reads stopped
+
+
 def test_kinematic_run_rejects_an_unknown_contact_rule():
     with pytest.raises(ValueError, match="on_contact='bounce': allowed: end, stop"):
         kinematic_run(empty_world(), Constant(0.0, 0.0), KinematicRobot("diffdrive", LIMITS, 0.35, 10), 1.0,
