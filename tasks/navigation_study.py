@@ -200,7 +200,8 @@ CAUSES = {
                "for A, 1.54 m for C; boxes that do not overlap keep 1.34 m apart), where the direction sensor "
                "keeps choosing the gap. (Touch-locks, halted against a box corner between the beams and asking "
                "for the same motion for good, ended when the controllers began to detect stalls by odometry.) "
-               "With 10 trials a cell, one failure costs 10 points of SR.",
+               "With 10 trials a cell, one failure costs 10 points of SR: a robot that arrives in 92 % of all "
+               "worlds shows 8 of 10 or fewer in at least one of four cells 56 % of the time (binomial).",
 }
 
 
@@ -243,8 +244,10 @@ def orderings(study: NavigationStudy, cells: dict) -> list[Ordering]:
     for robot in [r for r in ("A", "B") if r in study.robots]:
         sr = [cells[(robot, d, "FRC")].sr for d in study.densities if (robot, d, "FRC") in cells]
         if sr:
-            claims.append(Ordering(f"FRC success rate of robot {robot}", "> 88 %", f"{100 * min(sr):.0f} % at least",
-                                   min(sr) > 0.88, CAUSES["success"]))
+            per_density = "/".join(f"{100 * v:.0f}" for v in sr)
+            claims.append(Ordering(f"FRC success rate of robot {robot}", "> 88 %",
+                                   f"{100 * min(sr):.0f} % at least ({per_density} %)", min(sr) > 0.88,
+                                   CAUSES["success"]))
     return claims
 
 
