@@ -121,6 +121,10 @@ DRIVE_FORMS = {"tricycle": "tricycle", "differential": "differential", "diffdriv
                "tracked": "differential"}
 INVALID = -1.0  # the objectives' "otherwise" value
 STEER_REQUEST = 0.01  # rad/s: the turn-only command (0, +-this) that turns a standing tricycle's wheel
+# A stall (module notes; both chosen): driven at least this fast, m/s, the odometry reads under this share of it.
+STALL_DRIVEN_SPEED = 0.05
+STALL_SPEED_SHARE = 0.25
+NO_CONTACT = np.zeros((0, 2))  # obstacle points of no stall
 
 
 class Method(enum.Enum):
@@ -648,11 +652,10 @@ def _advance(pose: tuple[float, float, float], v: float, omega: float, dt: float
             float(wrap(th_new)))
 
 
-NO_CONTACT = np.zeros((0, 2))
-
 
 class _PoseTracker:
-    """Odometry from the controller's own commands, and the pose estimate: the last fix advanced by odometry."""
+    """Odometry (from the measured velocities, else the controller's own commands), and the pose estimate: the
+    last fix advanced by odometry."""
 
     def __init__(self, history_seconds: float):
         self.odometry = (0.0, 0.0, 0.0)
@@ -663,7 +666,7 @@ class _PoseTracker:
         self.time = None
 
     def update(self, time: float, fix, v: float, omega: float):
-        """Advance odometry to ``time`` under the last command (v, omega); take in a new fix. Returns the pose
+        """Advance odometry to ``time`` at (v, omega) over the period since the last update; take in a new fix. Returns the pose
         estimate (x, y, heading), or None before the first fix."""
         if self.time is not None:
             self.odometry = _advance(self.odometry, v, omega, time - self.time)
@@ -748,7 +751,8 @@ class DynamicWindowController:
         point of the enclosing circle the centre was moving towards, when the odometry shows the robot stopped
         although it was driven (a touch the IR ring did not see, such as a box corner between two beams).
         Empty when there is no stall."""
-        if velocity is None or abs(commanded.v) < 0.05 or abs(velocity[0]) > 0.25 * abs(commanded.v):
+        if (velocity is None or abs(commanded.v) < STALL_DRIVEN_SPEED
+                or abs(velocity[0]) > STALL_SPEED_SHARE * abs(commanded.v)):
             return NO_CONTACT
         bearing = math.atan2(commanded.omega * self.offset, commanded.v)
         return np.array([[self.offset + self.radius * math.cos(bearing), self.radius * math.sin(bearing)]])
@@ -761,7 +765,8 @@ class DynamicWindowController:
         seen = np.isfinite(ranges)
         reach = np.broadcast_to(self.sensor_radius, ranges.shape)[seen] + ranges[seen]
         body = np.column_stack([self.offset + reach * np.cos(bearings[seen]), reach * np.sin(bearings[seen])])
-        body = np.concatenate([body, contact])
+        if len(contact):
+            body = np.concatenate([body, contact])
         ox, oy, oth = self.tracker.odometry
         c, s = math.cos(oth), math.sin(oth)
         self.memory.append((obs.time, np.column_stack([ox + c * body[:, 0] - s * body[:, 1],

@@ -290,7 +290,7 @@ class World:
             ir_bearings=spec.ir_bearings, pose=self.positioning.fix(robot.name),
             inbox=tuple(self.radio.take_inbox(robot.name)),
             robots_present=self.radio.robots_present(robot.name, now),
-            motor_speeds=d.qvel[robot.motor_dofs], velocity=self.velocity(robot, now), touch=touch,
+            motor_speeds=d.qvel[robot.motor_dofs], velocity=self.read_odometry(robot, now), touch=touch,
             break_beams=(beams >= 0) & (beams < spec.beam_length),
             inclination=self.inclination(robot) if spec.inclinometer else None,
             effectors={name: self._effector_position(robot, name) for name in robot.effectors})
@@ -334,7 +334,7 @@ class World:
         q = self.data.qpos[robot.effectors[name][1]]
         return float((q - effector.ctrl_at_0) / (effector.ctrl_at_1 - effector.ctrl_at_0))
 
-    def velocity(self, robot: Robot, now: float) -> tuple[float, float]:
+    def read_odometry(self, robot: Robot, now: float) -> tuple[float, float]:
         """What the chassis's odometry reads at a control tick: (forward speed, m/s; turn rate, rad/s) over the
         period since the last tick, from the displacement, as encoder counts over a period give it (a sampled
         instantaneous velocity would carry the chassis's contact chatter). A blocked robot reads about zero
