@@ -548,7 +548,7 @@ class DynamicWindow:
 
         if self.tricycle:
             c_min, c_max = self.curvature_limits(state.steer)
-            w = float(np.clip(v_oppose * (c_min + c_max) / 2, w_lo, w_hi))
+            w = tricycle_turn(v_oppose, (c_min + c_max) / 2, (w_lo, w_hi))
         else:
             w = (w_lo + w_hi) / 2
         if self.towards(np.array([v_oppose]), np.array([w]), flagged)[0]:
@@ -613,10 +613,16 @@ class DynamicWindow:
         """The reachable velocity nearest a standstill; a tricycle keeps its steering angle."""
         v = float(np.clip(0.0, *v_window))
         if self.tricycle:
-            omega = v * math.tan(state.steer) / self.steering.wheelbase
+            omega = tricycle_turn(v, math.tan(state.steer) / self.steering.wheelbase, w_window)
         else:
-            omega = 0.0
-        return Decision(v, float(np.clip(omega, *w_window)), "brake", INVALID, v_min)
+            omega = float(np.clip(0.0, *w_window))
+        return Decision(v, omega, "brake", INVALID, v_min)
+
+
+def tricycle_turn(v: float, curvature: float, w_window: tuple[float, float]) -> float:
+    """A tricycle's turn rate at speed ``v`` along ``curvature``, within the angular window; none standing, whatever
+    the window (it has no point turns, and a turn-only command would turn its wheel instead)."""
+    return float(np.clip(v * curvature, *w_window)) if v else 0.0
 
 
 def _samples(lo: float, hi: float, count: int) -> np.ndarray:
@@ -666,8 +672,8 @@ class _PoseTracker:
         self.time = None
 
     def update(self, time: float, fix, v: float, omega: float):
-        """Advance odometry to ``time`` at (v, omega) over the period since the last update; take in a new fix. Returns the pose
-        estimate (x, y, heading), or None before the first fix."""
+        """Advance odometry to ``time`` at (v, omega), the velocities of the period since the last update; take in
+        a new fix. Returns the pose estimate (x, y, heading), or None before the first fix."""
         if self.time is not None:
             self.odometry = _advance(self.odometry, v, omega, time - self.time)
         self.time = time

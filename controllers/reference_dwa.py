@@ -290,12 +290,16 @@ def reference_decide(window: DynamicWindow, state: DriveState, points, heading: 
         return candidates[best][0], candidates[best][1], "secondary", v_min
 
     # The average curvature, unless it heads for a flagged point: then brake.
+    # A standing tricycle does not turn.
     if window.tricycle:
-        w = _clip(v_oppose * (c_min + c_max) / 2, w_lo, w_hi)
+        w = _clip(v_oppose * (c_min + c_max) / 2, w_lo, w_hi) if v_oppose else 0.0
     else:
         w = (w_lo + w_hi) / 2
     if not _towards(v_oppose, w, flagged, offset, radius):
         return v_oppose, w, "curvature", v_min
     v = _clip(0.0, v_wmin, v_wmax)
-    w = v * math.tan(state.steer) / window.steering.wheelbase if window.tricycle else 0.0
-    return v, _clip(w, w_lo, w_hi), "brake", v_min
+    if window.tricycle:
+        w = _clip(v * math.tan(state.steer) / window.steering.wheelbase, w_lo, w_hi) if v else 0.0
+    else:
+        w = _clip(0.0, w_lo, w_hi)
+    return v, w, "brake", v_min
