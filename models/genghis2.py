@@ -32,7 +32,7 @@ TRIPOD_PHASE = (0.0, 0.5, 0.0, 0.5, 0.0, 0.5)  # gait phase offset of each leg, 
 
 @dataclass(frozen=True)
 class GaitSpec:
-    """What the tripod gait (``teamsim.controllers.gait.TripodGait``) needs to know about the legs.
+    """What the tripod gait (``teamsim.controllers.skills.gait.TripodGait``) needs to know about the legs.
 
     Per-leg tuples follow :data:`LEGS`. ``foot_y`` is each foot's lateral position in the body frame (m,
     left positive), which sets how much a leg's stride changes with the turn rate."""

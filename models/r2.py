@@ -39,7 +39,7 @@ from teamsim.models.parts import GRAVITY, add_caster, add_livery, add_velocity_m
 from teamsim.models.robot import DifferentialSpec, DriveLimits, Effector, RobotModel, add_tracking_camera, colour_of
 
 POUND = 0.45359237  # kg
-# Sensor names the gripper behaviours look up (teamsim.controllers.gripper).
+# Sensor names the gripper behaviours look up (teamsim.controllers.skills.gripper).
 TIP_IR = ("ir_tip_left", "ir_tip_right")
 BEAMS = ("beam_front", "beam_rear")
 GRIP_TOUCH = "fingers"

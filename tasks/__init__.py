@@ -1,8 +1,9 @@
-"""Missions and studies: each sets up a world, defines success and measures."""
+"""Tasks: the missions (``missions/``), the worlds drawn for them or run without physics (``worlds/``), and the
+studies that sweep them (``studies/``). ``MISSIONS`` names every mission ``teamsim run`` knows."""
 from __future__ import annotations
 
-from teamsim.tasks.hazardous_waste import HazardousWasteMission
-from teamsim.tasks.navigate import NavigateMission
-from teamsim.tasks.wander import WanderMission
+from teamsim.tasks.missions.hazardous_waste import HazardousWasteMission
+from teamsim.tasks.missions.navigate import NavigateMission
+from teamsim.tasks.missions.wander import WanderMission
 
 MISSIONS = {mission.name: mission for mission in (WanderMission(), NavigateMission(), HazardousWasteMission())}

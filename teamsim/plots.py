@@ -6,7 +6,7 @@ from pathlib import Path
 import cv2
 import numpy as np
 
-from teamsim.recording import write_atomic
+from teamsim.files import write_atomic
 
 _FONT = cv2.FONT_HERSHEY_SIMPLEX
 _COLOURS = [(180, 119, 31), (14, 127, 255), (44, 160, 44), (40, 39, 214), (189, 103, 148), (75, 86, 140),

@@ -18,68 +18,19 @@ small (the full series is in ``trajectory.npz``).
 """
 from __future__ import annotations
 
-import csv
 import io
-import json
-import math
 import os
 from array import array
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Callable, Iterable, Sequence
+from typing import Callable
 
 import numpy as np
 
 from teamsim.controllers.base import MotivationTrace
+from teamsim.files import to_json, write_atomic
 
 SAMPLE_PERIOD = 1.0  # s of simulated time between motivation samples in events.jsonl while nothing happens
-
-
-def _jsonable(value: Any) -> Any:
-    """Plain-JSON form: non-finite floats become strings ("inf"), numpy scalars become Python ones."""
-    if isinstance(value, dict):
-        return {str(k): _jsonable(v) for k, v in value.items()}
-    if isinstance(value, (list, tuple, set, frozenset)):
-        items = sorted(value) if isinstance(value, (set, frozenset)) else value
-        return [_jsonable(v) for v in items]
-    if isinstance(value, np.generic):
-        value = value.item()
-    if isinstance(value, np.ndarray):
-        return _jsonable(value.tolist())
-    if isinstance(value, float) and not math.isfinite(value):
-        return str(value)
-    return value
-
-
-def to_json(value: Any, **kwargs) -> str:
-    return json.dumps(_jsonable(value), allow_nan=False, **kwargs)
-
-
-def write_atomic(path: Path, data: bytes) -> None:
-    tmp = path.with_name(path.name + ".tmp")
-    with open(tmp, "wb") as handle:
-        handle.write(data)
-        handle.flush()
-        os.fsync(handle.fileno())
-    os.replace(tmp, path)
-
-
-def write_csv(path: Path, columns: Sequence[str], rows: Iterable[dict], float_format: str | None = None) -> None:
-    """A study's results table, one row per trial, written atomically. With ``float_format`` (e.g. ".6g"), floats
-    are written in it and NaN as an empty cell."""
-    buffer = io.StringIO()
-    writer = csv.DictWriter(buffer, fieldnames=list(columns), lineterminator="\n")
-    writer.writeheader()
-    for row in rows:
-        if float_format is not None:
-            row = {k: ("" if math.isnan(v) else format(v, float_format)) if isinstance(v, float) else v
-                   for k, v in row.items()}
-        writer.writerow(row)
-    write_atomic(path, buffer.getvalue().encode())
-
-
-def write_json(path: Path, value: Any) -> None:
-    write_atomic(path, (to_json(value, indent=2) + "\n").encode())
 
 
 class EventLog:

@@ -20,8 +20,9 @@ import numpy as np
 
 import teamsim
 from teamsim.config import ConfigError, TrialConfig, validate
+from teamsim.files import write_json
 from teamsim.progress import Progress
-from teamsim.recording import EventLog, MotivationRecorder, TrajectoryRecorder, write_json
+from teamsim.recording import EventLog, MotivationRecorder, TrajectoryRecorder
 from teamsim.scenario import resolve, scenario_of, to_data
 from teamsim.tasks import MISSIONS
 from teamsim.timeline import write_timeline

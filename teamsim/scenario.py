@@ -38,6 +38,7 @@ from teamsim.models import ROBOT_BUILDERS, ROBOT_KINDS, build_robot
 from teamsim.models.arenas import OBSTACLE_RGBA, Bog, Box, add_bog, walled_room
 from teamsim.models.objects import BoxDims, PuckDims, box, place, place_puck
 from teamsim.models.robot import TricycleSpec
+from teamsim.scene import RobotSlot, Scene
 
 MAX_EXTENT = 1000.0  # m: bound on every position and size, so that a typo (or inf) is caught as out of range
 ROBOT_NAME = re.compile(r"^[A-Za-z0-9_-]+$")  # what a fault spec (ROBOT@...) and an MJCF prefix accept
@@ -488,8 +489,6 @@ def obstacles(arena: Arena) -> list[Obstacle]:
 def scene_of(scenario: Scenario, newcomers: list[tuple[str, str]], physics_dt: float):
     """The Scene a scenario describes (``teamsim.tasks.base.Scene``); robots named in ``newcomers`` (add-robot
     faults' (name, kind)) wait outside the arena until their fault fires."""
-    from teamsim.tasks.base import RobotSlot, Scene  # noqa: PLC0415  (teamsim.tasks imports this module)
-
     a = scenario.arena
     boxes = [b for b in a.boxes] + [b for b, _ in image_boxes(a)]
     arena = walled_room(*a.size, wall_height=a.wall_height, wall_thickness=a.wall_thickness,

@@ -15,7 +15,8 @@ from typing import Mapping
 import cv2
 import numpy as np
 
-from teamsim.recording import MotivationSeries, write_atomic
+from teamsim.files import write_atomic
+from teamsim.recording import MotivationSeries
 
 _FONT = cv2.FONT_HERSHEY_SIMPLEX
 # Distinct colours (BGR) for behaviours, in order of first appearance; idle, dead and absent are fixed greys.

@@ -21,7 +21,7 @@ import numpy as np
 
 from teamsim.config import ConfigError, TrialConfig
 from teamsim.controllers.base import Command, Observation
-from teamsim.controllers.locomotion import make_locomotion
+from teamsim.controllers.skills.locomotion import make_locomotion
 from teamsim.faults import Fault, Health, apply_fault
 from teamsim.models import ROBOT_BUILDERS, build_robot
 from teamsim.models.robot import RobotModel
@@ -47,7 +47,7 @@ class Robot:
     """One robot in the world: its model, controller, health and bookkeeping."""
     model: RobotModel
     controller: object
-    drive: object  # the locomotion controller (teamsim.controllers.locomotion)
+    drive: object  # the locomotion controller (teamsim.controllers.skills.locomotion)
     ir_rng: np.random.Generator
     dormant: bool
     spawn: tuple[float, float, float]

@@ -5,7 +5,7 @@ import teamsim  # noqa: F401  (chooses the GL backend before mujoco is imported)
 from teamsim.config import TrialConfig
 from teamsim.controllers.base import Command
 from teamsim.tasks import MISSIONS
-from teamsim.tasks.wander import WanderMission
+from teamsim.tasks.missions.wander import WanderMission
 
 
 def wander_config(tmp_path, **overrides) -> TrialConfig:

@@ -8,8 +8,8 @@ import numpy as np
 
 import teamsim  # noqa: F401  (GL backend before mujoco)
 from teamsim.controllers.base import Command
-from teamsim.tasks.base import RobotSlot
-from teamsim.tasks.custom import CustomMission, CustomParams, custom_config
+from teamsim.scene import RobotSlot
+from teamsim.tasks.missions.custom import CustomMission, CustomParams, custom_config
 from teamsim.world import World
 
 __all__ = ["Scripted", "RobotSlot", "CustomParams", "make_world", "run_for", "body_pose"]

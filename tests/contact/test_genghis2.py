@@ -1,6 +1,6 @@
 """Contact regression: Genghis-II (Parker §2.2.2) walks, turns, stands, pushes and senses through the full World.
 
-The robot runs a tripod gait (``teamsim.controllers.gait``) under a scripted (v, omega). What Parker says and
+The robot runs a tripod gait (``teamsim.controllers.skills.gait``) under a scripted (v, omega). What Parker says and
 these tests hold it to: it walks (slower than an R-2's 0.457 m/s, §2.2.1), it pushes the long box more weakly
 than an R-2 (§6.1.1: "cannot push the box as quickly as an R-2, due to less powerful effectors"), and its
 whiskers, shoulder IR, inclinometer and belly tactile sensors read what they touch or see. Speeds, push forces

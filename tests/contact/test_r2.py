@@ -16,7 +16,7 @@ import mujoco
 import numpy as np
 import pytest
 
-from teamsim.controllers import gripper as G
+from teamsim.controllers.skills import gripper as G
 from teamsim.models.objects import BoxDims, PuckDims
 from teamsim.models.r2 import R2Dims, build
 from teamsim.world import yaw_of

@@ -1,0 +1,313 @@
+"""Random obstacle worlds of Chand's navigation experiments (§3.6.2): 15 m x 15 m, evenly distributed rectilinear
+obstacles at 5, 10, 15 and 20 % density, the robot crossing from the top-left corner to the bottom-right (Fig 3.9).
+
+The thesis gives neither the obstacles' sizes nor how they were spread, only that they were "evenly distributed"
+and automatically generated. Here (choices, in ``NavWorldParams``):
+  - obstacles are axis-aligned boxes with half-sides drawn uniformly from ``half_size_range``: 1 m to 2 m across,
+    large enough that the IR ring cannot miss one well inside its range (a box 1 m wide spans the 36 degrees
+    between adjacent beams of a ten-sensor ring out to 1.6 m from its centre);
+  - the world is divided into a square grid of strata, about one per obstacle expected, visited in a random order
+    again and again; each visit tries to drop one box at a uniform position in its stratum that keeps clear of
+    the start's and the goal's discs and leaves ``min_gap`` to the walls and to every box it does not overlap
+    (a jittered grid: even, yet random). Boxes that overlap or touch make one larger obstacle;
+  - ``min_gap`` is Table 3.1's largest robot's diameter (Robot C, 1.34 m): no gap between obstacles is too
+    narrow for any of the robots' bodies, though Robot C (1.54 m with its safety margin) and the tricycle, which
+    needs room to turn, still meet tight places and do worse at high density, as in the thesis. The thesis's
+    results call for such worlds: Robot C reached the goal in 80 % of its 20 % worlds, A and B in more than 88 %
+    of all of them. An earlier reading, boxes kept 0.7 m apart (Robot B's diameter) and never overlapping, left
+    most gaps narrower than A or C with their safety margins: in the first ten such layouts at 20 % density only
+    one had a way through for Robot C's body and four for Robot A with its margin, and FRC reached the goal with
+    A in none of ten (docs/navigation.md). Wider gaps between boxes that may not overlap cannot reach 15 % at
+    all: the layouts jam, which is also why the thesis found even distributions "computationally difficult" at
+    higher densities;
+  - boxes are added until the covered fraction of the occupancy raster is as close to the density as one more
+    box could bring it;
+  - a layout is kept only if a circle of ``passage_radius`` (Robot C's) can get from the start to the goal:
+    merged obstacles can still close every way through, and a world with none measures the world, not the
+    controller (at 20 % about one layout in fifteen is dropped for this).
+Density is measured on the occupancy raster (a cell is occupied when its centre lies in a box), which is also
+the known map the deliberative planners get. The world is centred on the origin, as ``walled_room`` builds it.
+
+``kinematic_run`` drives a navigation controller through a world without physics (ideal IR ranges by ray casting,
+unicycle or bicycle kinematics): the smoke test of the controllers and the timing of their decisions.
+"""
+from __future__ import annotations
+
+import math
+import time as time_module
+from dataclasses import dataclass
+
+import numpy as np
+
+from teamsim.controllers.base import Observation
+from teamsim.controllers.navigation.astar import modified_astar
+from teamsim.controllers.navigation.occupancy_grid import OccupancyGrid
+from teamsim.controllers.skills.locomotion import SlewLimiter, next_steer
+from teamsim.models.arenas import Box
+from teamsim.models.robot import DriveLimits
+from teamsim.positioning import PoseFix
+from teamsim.scenario import Obstacle
+
+DENSITIES = (0.05, 0.10, 0.15, 0.20)  # §3.6.2
+
+
+@dataclass(frozen=True)
+class NavWorldParams:
+    size: float = 15.0  # m, side of the square world (§3.6.2)
+    resolution: float = 0.1  # m, occupancy raster cell
+    half_size_range: tuple[float, float] = (0.5, 1.0)  # m, obstacle half-sides: not given, chosen
+    min_gap: float = 1.34  # m, least gap between boxes that do not overlap, and to a wall (see above)
+    corner_margin: float = 1.5  # m from each wall to the start and the goal
+    clear_radius: float = 1.2  # m around the start and the goal kept free of obstacles
+    attempts: int = 20  # placements tried per stratum visit before moving on
+    max_rounds: int = 10  # passes over the strata before a layout is given up
+    passage_radius: float = 0.67  # m, the circle that must fit from the start to the goal (Robot C, Table 3.1)
+    layouts: int = 200  # layouts tried before giving up on a density
+
+
+@dataclass(frozen=True)
+class NavWorld:
+    boxes: tuple[Box, ...]
+    occupancy: np.ndarray  # bool (rows, cols), row along world y, column along x
+    origin: tuple[float, float]  # world position of the raster's lower-left corner
+    resolution: float
+    size: float
+    start: tuple[float, float, float]  # x, y, heading (facing the goal)
+    goal: tuple[float, float]
+
+    @property
+    def density(self) -> float:
+        return float(self.occupancy.mean())
+
+    def known_map(self) -> OccupancyGrid:
+        """The occupancy raster as a known map, for HRDK."""
+        return OccupancyGrid.known(self.origin, self.resolution, self.occupancy)
+
+    def unexplored_map(self) -> OccupancyGrid:
+        """An unexplored map of the same extent, for HRDU."""
+        return OccupancyGrid.unexplored(self.origin, self.resolution, self.occupancy.shape)
+
+
+def cell_centres(size: float, resolution: float) -> np.ndarray:
+    """The centres of a square raster's cells along either axis, the world centred on the origin."""
+    return -size / 2 + (np.arange(round(size / resolution)) + 0.5) * resolution
+
+
+def covered_cells(obstacle: Obstacle, centres: np.ndarray) -> np.ndarray:
+    """(rows, cols) bool: the cells whose centre lies in the obstacle (row along world y, column along x); the
+    occupancy raster, and with it the density, is the union of its obstacles' covered cells."""
+    return obstacle.distance(centres[None, :], centres[:, None]) <= 0
+
+
+def random_world(density: float, rng: np.random.Generator, params: NavWorldParams = NavWorldParams()) -> NavWorld:
+    """A world of the given obstacle density (a fraction), reproducible from ``rng``."""
+    half = params.size / 2
+    origin = (-half, -half)
+    start = (-half + params.corner_margin, half - params.corner_margin)
+    goal = (half - params.corner_margin, -half + params.corner_margin)
+    heading = math.atan2(goal[1] - start[1], goal[0] - start[0])
+
+    # A layout that jams short of the density, or leaves no passage, is dropped and the next drawn.
+    for _ in range(params.layouts):
+        layout = _layout(density, rng, params, (start, goal))
+        if layout is None:
+            continue
+        boxes, occupancy = layout
+        world = NavWorld(boxes, occupancy, origin, params.resolution, params.size, (start[0], start[1], heading), goal)
+        if has_passage(world, params.passage_radius):
+            return world
+    raise RuntimeError(f"could not reach {density:.0%} obstacle density with a passage for a "
+                       f"{params.passage_radius} m circle in {params.layouts} layouts")
+
+
+def _layout(density: float, rng: np.random.Generator, params: NavWorldParams,
+            keep_clear) -> tuple[tuple[Box, ...], np.ndarray] | None:
+    """Boxes dropped stratum by stratum until the density is reached, with their occupancy raster; None if the
+    layout jams first."""
+    half = params.size / 2
+    centres = cell_centres(params.size, params.resolution)
+    cells = len(centres)
+    lo, hi = params.half_size_range
+    mean_area = 4 * ((lo + hi) / 2) ** 2
+    strata = max(1, round(math.sqrt(density * params.size ** 2 / mean_area)))
+    stratum = params.size / strata
+    target = density * cells * cells
+    occupancy = np.zeros((cells, cells), bool)
+    boxes: list[Box] = []
+    for _ in range(params.max_rounds):
+        for k in rng.permutation(strata * strata):
+            row, col = divmod(int(k), strata)
+            footprint = _place(rng, params, (-half + col * stratum, -half + row * stratum), stratum,
+                               centres, boxes, keep_clear)
+            if footprint is None:
+                continue
+            box, covered = footprint
+            added = np.count_nonzero(covered & ~occupancy)  # an overlapping box adds only its new cells
+            if added == 0:
+                continue
+            occupied = np.count_nonzero(occupancy)
+            if abs(occupied + added - target) >= abs(occupied - target):
+                return tuple(boxes), occupancy
+            occupancy |= covered
+            boxes.append(box)
+    return None
+
+
+def _place(rng: np.random.Generator, params: NavWorldParams, corner: tuple[float, float], stratum: float,
+           centres: np.ndarray, boxes: list[Box], keep_clear) -> tuple[Box, np.ndarray] | None:
+    """A box centred in the stratum with lower-left ``corner``, ``min_gap`` inside the world, clear of the start
+    and the goal, and either overlapping or ``min_gap`` from every box in ``boxes``; with its raster footprint.
+    None if no attempt fits."""
+    inside = params.size / 2 - params.min_gap
+    for _ in range(params.attempts):
+        hx, hy = rng.uniform(*params.half_size_range, size=2)
+        x = corner[0] + rng.uniform(0, stratum)
+        y = corner[1] + rng.uniform(0, stratum)
+        if abs(x) + hx > inside or abs(y) + hy > inside:
+            continue
+        if any(math.hypot(max(abs(px - x) - hx, 0.0), max(abs(py - y) - hy, 0.0)) < params.clear_radius
+               for px, py in keep_clear):
+            continue
+        if any(0 < math.hypot(max(abs(b.x - x) - hx - b.half_x, 0.0), max(abs(b.y - y) - hy - b.half_y, 0.0))
+               < params.min_gap for b in boxes):
+            continue
+        return Box(float(x), float(y), float(hx), float(hy)), covered_cells(Obstacle("box", x, y, hx, hy), centres)
+    return None
+
+
+def has_passage(world: NavWorld, radius: float) -> bool:
+    """Whether a circle of ``radius`` can get from the start to the goal without touching a box or a wall:
+    A* on the occupancy raster bordered by the walls, occupied cells inflated by the radius and one cell more
+    (a box's edge can lie up to a cell beyond the centres of the cells it covers)."""
+    walled = np.pad(world.occupancy, 1, constant_values=True)
+    grid = world.known_map()
+
+    def cell(xy):  # in the walled raster, one cell in from the unwalled one
+        row, col = grid.world_to_cell(xy[0], xy[1])
+        return int(row) + 1, int(col) + 1
+
+    return modified_astar(walled.astype(float), cell(world.start), cell(world.goal),
+                          inflation_cells=radius / world.resolution + 1).reached
+
+
+def ray_ranges(world: NavWorld, origins: np.ndarray, directions: np.ndarray, max_range: float) -> np.ndarray:
+    """Ideal range readings: distance from each origin (n, 2) along its unit direction (n, 2) to the first box
+    face or wall, ``inf`` beyond ``max_range`` (slab intersection, all rays and boxes at once)."""
+    lo = np.array([[b.x - b.half_x, b.y - b.half_y] for b in world.boxes]).reshape(-1, 2)
+    hi = np.array([[b.x + b.half_x, b.y + b.half_y] for b in world.boxes]).reshape(-1, 2)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        inverse = 1.0 / directions  # inf along an axis the ray does not move on: the slab test still holds
+        t1 = (lo[None] - origins[:, None]) * inverse[:, None]
+        t2 = (hi[None] - origins[:, None]) * inverse[:, None]
+        near = np.nanmax(np.minimum(t1, t2), axis=2)
+        far = np.nanmin(np.maximum(t1, t2), axis=2)
+        half = world.size / 2
+        wall = np.nanmin(np.maximum((-half - origins) * inverse, (half - origins) * inverse), axis=1)
+    boxes = np.where((near <= far) & (near >= 0), near, np.inf).min(axis=1, initial=np.inf)
+    distance = np.minimum(boxes, wall)
+    return np.where(distance < max_range, distance, np.inf)
+
+
+def clearance(world: NavWorld, x: float, y: float) -> float:
+    """Distance from a point to the nearest box or wall."""
+    half = world.size / 2
+    walls = half - max(abs(x), abs(y))
+    boxes = [math.hypot(max(abs(x - b.x) - b.half_x, 0.0), max(abs(y - b.y) - b.half_y, 0.0)) for b in world.boxes]
+    return min([walls] + boxes)
+
+
+@dataclass(frozen=True)
+class KinematicRobot:
+    """What a physics-free run needs of a robot: its drive, its enclosing circle and its IR ring (evenly spaced
+    over 360 degrees from straight ahead, on the circle, as ``add_ir_ring`` builds them)."""
+    kind: str  # "tricycle" or a differential kind
+    limits: DriveLimits
+    radius: float  # enclosing circle, m
+    ir_count: int
+    ir_range: float = 1.5
+    centre_offset: float = 0.0  # the circle's centre ahead of the pose's reference point
+    sensor_radius: tuple[float, ...] = ()  # each sensor's distance from the centre; () puts them on the circle
+    wheelbase: float = 0.5  # tricycle only, as TricycleDims assumes
+    steer_max: float = math.radians(60)
+    steer_rate_max: float = 1.0
+
+
+@dataclass(frozen=True)
+class KinematicRun:
+    reached: bool  # the controller reported "arrived"
+    collided: bool  # the enclosing circle touched a box or wall (and the run ended there: on_contact="end")
+    time: float  # s simulated
+    min_clearance: float  # m, between the enclosing circle and the nearest box or wall
+    decision_times: np.ndarray  # s of wall time per controller call
+    travelled: float = 0.0  # m along the path of the pose's reference point
+    touches: int = 0  # control ticks whose motion was refused because it would have touched (on_contact="stop")
+    pose: tuple[float, float, float] = (0.0, 0.0, 0.0)  # where the run ended
+
+
+def kinematic_run(world: NavWorld, controller, robot: KinematicRobot, duration: float,
+                  control_dt: float = 0.1, substeps: int = 5, on_contact: str = "end") -> KinematicRun:
+    """Drive ``controller`` from the world's start with ideal IR ranges and exact positioning fixes every control
+    tick. The command is clipped and slewed by the drive limits as the locomotion does; a tricycle's front wheel
+    turns as the locomotion turns it (``locomotion.next_steer``) and the robot then follows the bicycle model, a
+    differential drive follows the unicycle model.
+
+    ``on_contact`` says what a motion that would make the enclosing circle touch a box or wall does: "end" ends
+    the run there as a collision; "stop" refuses that tick's motion and halts the robot (v = omega = 0), the way a
+    bumper stops a real robot and a touch stops (but does not end) a physics run. Each observation carries the
+    odometry of the last tick's motion (``Observation.velocity``): zero after a halt."""
+    if on_contact not in ("end", "stop"):
+        raise ValueError(f"on_contact={on_contact!r}: allowed: end, stop")
+    slew = SlewLimiter(robot.limits, control_dt)
+    x, y, heading = world.start
+    steer = 0.0
+    bearings = 2 * np.pi * np.arange(robot.ir_count) / robot.ir_count
+    sensor_radius = np.asarray(robot.sensor_radius or (robot.radius,) * robot.ir_count, float)
+    decision_times = []
+    min_clearance = math.inf
+    travelled, touches = 0.0, 0
+    velocity = (0.0, 0.0)
+    steps = round(duration / control_dt)
+
+    def run(reached: bool, collided: bool, time_end: float) -> KinematicRun:
+        return KinematicRun(reached, collided, time_end, min_clearance, np.array(decision_times), travelled,
+                            touches, (x, y, heading))
+
+    for tick in range(steps):
+        time_now = tick * control_dt
+        cx, cy = x + robot.centre_offset * math.cos(heading), y + robot.centre_offset * math.sin(heading)
+        directions = np.column_stack([np.cos(heading + bearings), np.sin(heading + bearings)])
+        ranges = ray_ranges(world, np.array([cx, cy]) + sensor_radius[:, None] * directions, directions,
+                            robot.ir_range)
+        observation = Observation(time=time_now, robot="kinematic", ir_raw=ranges, ir_range=ranges,
+                                  ir_bearings=bearings, pose=PoseFix(x, y, heading, time_now), velocity=velocity)
+        began = time_module.perf_counter()
+        command = controller(observation)
+        decision_times.append(time_module.perf_counter() - began)
+        if command.behaviour == "arrived":
+            return run(True, False, time_now)
+        v, omega = slew(command.v, command.omega)
+        turn_rate = omega
+        if robot.kind == "tricycle":
+            steer = next_steer(steer, v, omega, (command.v, command.omega), robot, control_dt)
+            turn_rate = v * math.tan(steer) / robot.wheelbase
+        dt = control_dt / substeps
+        nx, ny, nheading = x, y, heading
+        for _ in range(substeps):
+            nx += v * dt * math.cos(nheading)
+            ny += v * dt * math.sin(nheading)
+            nheading += turn_rate * dt
+        nheading = (nheading + math.pi) % (2 * math.pi) - math.pi
+        cx, cy = nx + robot.centre_offset * math.cos(nheading), ny + robot.centre_offset * math.sin(nheading)
+        gap = clearance(world, cx, cy) - robot.radius
+        if gap < 0 and on_contact == "stop":
+            touches += 1
+            slew.reset()
+            velocity = (0.0, 0.0)
+            continue
+        travelled += math.hypot(nx - x, ny - y)
+        x, y, heading = nx, ny, nheading
+        velocity = (v, turn_rate)
+        min_clearance = min(min_clearance, gap)
+        if gap < 0:
+            return run(False, True, time_now + control_dt)
+    return run(False, False, steps * control_dt)

@@ -1,0 +1,337 @@
+"""``teamsim``: run missions headless, render videos, export robots, benchmark.
+
+Every bad input ends in one line, ``teamsim: error: ...``, and exit status 2.
+"""
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+from pathlib import Path
+
+from teamsim.config import ConfigError, TrialConfig, apply_setting, validate
+from teamsim.faults import FAULT_KINDS, SPEC_FORM, parse_fault
+from teamsim.gl import RenderBackendError
+
+# teamsim.tasks.studies.cleanup_faults.CONDITIONS, spelled out so that building the parser imports no physics
+CLEANUP_CONDITIONS = ("none", "kill-red", "radio-off", "break-gripper")
+
+EXIT_USAGE = 2
+
+
+class UsageError(Exception):
+    pass
+
+
+class _Parser(argparse.ArgumentParser):
+    def error(self, message: str):  # one line, not argparse's usage block
+        raise UsageError(message)
+
+
+def _build_parser() -> argparse.ArgumentParser:
+    parser = _Parser(prog="teamsim", description=__doc__.splitlines()[0])
+    commands = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
+    commands.add_parser("list", help="robots, missions and studies")
+
+    run = commands.add_parser("run", help="run one trial of a mission")
+    _trial_arguments(run)
+    run.add_argument("--video", action="store_true", help="write video.mp4 (H.264)")
+    run.add_argument("--camera", default="top", help="'top' or a robot name for its tracking camera")
+    run.add_argument("--out", default="renders", help="output root (default: renders)")
+    run.add_argument("--run-id", help="run folder name (default: seed and timestamp)")
+
+    scenario = commands.add_parser("scenario", help="scenario files: a world, a team and its faults in one YAML "
+                                                    "file (docs/scenarios.md)")
+    scenario_commands = scenario.add_subparsers(dest="scenario_command", required=True, parser_class=_Parser)
+    show = scenario_commands.add_parser("show", help="print the exact scenario a run would use")
+    _trial_arguments(show)
+    show.add_argument("--output", type=Path, metavar="FILE", help="write it to FILE instead")
+    show.set_defaults(video=False, camera="top", out="renders", run_id=None)
+
+    render = commands.add_parser("render", help="re-render a run's video from its trajectory.npz")
+    render.add_argument("run_dir", type=Path)
+    render.add_argument("--camera", default="top")
+    render.add_argument("--out", type=Path, help="video path (default: RUN_DIR/video-CAMERA.mp4)")
+    render.add_argument("--width", type=int, default=640)
+    render.add_argument("--height", type=int, default=480)
+
+    export = commands.add_parser("export", help="standalone MJCF of one robot on a floor")
+    export.add_argument("robot")
+    export.add_argument("--out", type=Path, required=True)
+
+    allocate = commands.add_parser("allocate", help="Chand ch.5: fuzzy task allocation (default: the thesis's "
+                                                    "Tables 5.20-5.22)")
+    allocate.add_argument("tasks", nargs="?", type=Path, help="task specification (TOML)")
+    allocate.add_argument("robots", nargs="?", type=Path, help="robot specification (TOML)")
+    allocate.add_argument("--json", action="store_true", help="the same data as JSON")
+    allocate.add_argument("--explain", action="store_true", help="each FIS's inputs, fired rules and output")
+
+    study = commands.add_parser("study", help="re-run a thesis's experiments and compare with its figures")
+    studies = study.add_subparsers(dest="study", required=True, parser_class=_Parser)
+    navigation = studies.add_parser("navigation", help="Chand ch.3: navigation methods x robots x densities")
+    navigation.add_argument("--robots", type=_csv_of("robot", ("A", "B", "C", "tricycle", "diffdrive", "tracked")))
+    navigation.add_argument("--densities", type=_csv_of("density", None, float))
+    navigation.add_argument("--controllers", type=_csv_of("controller", ("FRC", "HRDK", "HRDU", "ODW", "ODWDS",
+                                                                      "RFRC")))
+    navigation.add_argument("--trials", type=_positive_int("--trials"))
+    navigation.add_argument("--workers", type=_positive_int("--workers"))
+    navigation.add_argument("--seed", type=int)
+    navigation.add_argument("--out", type=Path, default=Path("renders/study-navigation"))
+    navigation.add_argument("--backend", choices=("kinematic", "physics"),
+                            help="kinematic (default: no dynamics, as the thesis simulated; minutes) or physics "
+                                 "(every trial a MuJoCo navigate mission)")
+
+    two_tier = studies.add_parser("two-tier-astar", help="Chand ch.4: memory-constrained vs monolithic A*")
+    two_tier.add_argument("--trials", type=_positive_int("--trials"), help="worlds per size and density")
+    _sweep_options(two_tier, "§4.6's whole grid of sizes and local maps (hours)", workers=1,
+                   out="renders/study-two-tier-astar")
+
+    lalliance = studies.add_parser("lalliance", help="Parker §4.5: abstract L-ALLIANCE allocation study")
+    lalliance.add_argument("--runs", type=_positive_int("--runs"), help="runs per scenario")
+    _sweep_options(lalliance, "the thesis's full sweep (slow)", workers=2, out="renders/study-lalliance")
+
+    awareness = studies.add_parser("awareness", help="Parker ch.5: hazardous waste with and without awareness, "
+                                                     "2 and 3 robots (versions I-IV)")
+    awareness.add_argument("--missions", type=_positive_int("--missions"), default=10, help="missions per version")
+    awareness.add_argument("--duration", type=float, help="simulated seconds per mission (mission default if unset)")
+    awareness.add_argument("--workers", type=_positive_int("--workers"), default=2)
+    awareness.add_argument("--seed", type=int, default=0)
+    awareness.add_argument("--out", type=Path, default=Path("renders/study-awareness"))
+
+    faults = studies.add_parser("cleanup-faults", help="Parker §3.8.4: the 3-robot cleanup with red killed during "
+                                                       "the search, the radio off, a gripper broken")
+    faults.add_argument("--missions", type=_positive_int("--missions"), default=10, help="missions per condition")
+    faults.add_argument("--conditions", type=_csv_of("condition", CLEANUP_CONDITIONS), default=CLEANUP_CONDITIONS,
+                        help=f"comma-separated: {','.join(CLEANUP_CONDITIONS)}")
+    faults.add_argument("--workers", type=_positive_int("--workers"), default=2)
+    faults.add_argument("--seed", type=int, default=0)
+    faults.add_argument("--out", type=Path, default=Path("renders/study-cleanup-faults"))
+
+    bench = commands.add_parser("bench", help="benchmarks")
+    bench.add_argument("what", choices=("physics", "cleanup", "render", "nav", "alliance", "allocate"))
+    bench.add_argument("--seconds", type=float, default=None, help="simulated seconds per measurement")
+    return parser
+
+
+def _trial_arguments(parser: argparse.ArgumentParser) -> None:
+    """What defines a trial, for `run` and `scenario show` (precedence: teamsim/cli/scenario.py)."""
+    parser.add_argument("mission")
+    parser.add_argument("--scenario", type=Path, metavar="FILE", help="scenario file (YAML) to run")
+    parser.add_argument("--seed", type=int, help="trial seed (default: the scenario's, else 0)")
+    parser.add_argument("--duration", type=float, help="simulated seconds (default: the scenario's or mission's)")
+    parser.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
+                        help="mission parameter (robots=5), group.key (radio.loss=0.2) or any scenario field by "
+                             "its dotted path (robots.red.pose=[1,2,0])")
+    parser.add_argument("--fault", action="append", default=[], metavar="SPEC",
+                        help=f"{SPEC_FORM}; kinds: {', '.join(FAULT_KINDS)}")
+
+
+def _sweep_options(parser: argparse.ArgumentParser, full_help: str, workers: int, out: str) -> None:
+    """--full, --workers, --seed and --out of a study that runs a reduced grid unless asked for the full one."""
+    parser.add_argument("--full", action="store_true", help=full_help)
+    parser.add_argument("--workers", type=_positive_int("--workers"), default=workers)
+    parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--out", type=Path, default=Path(out))
+
+
+def _csv_of(name: str, allowed: tuple | None, kind=str):
+    """An argparse type: a comma-separated list of ``kind`` values, each in ``allowed`` when given."""
+    def parse(text: str) -> tuple:
+        try:
+            values = tuple(kind(item.strip()) for item in text.split(",") if item.strip())
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{name}s must be {kind.__name__}s separated by commas") from None
+        bad = [v for v in values if allowed is not None and v not in allowed]
+        if bad or not values:
+            raise argparse.ArgumentTypeError(f"{name} {bad[0] if bad else text!r} not allowed; allowed: "
+                                             f"{', '.join(map(str, allowed or ()))}")
+        return values
+    return parse
+
+
+def _positive_int(flag: str):
+    def parse(text: str) -> int:
+        if not text.isdigit() or int(text) < 1:
+            raise argparse.ArgumentTypeError(f"{flag} must be a whole number >= 1")
+        return int(text)
+    return parse
+
+
+def cmd_study(args) -> int:
+    if args.study == "navigation":
+        from teamsim.tasks.studies.navigation import run_study, study_from_args
+
+        if args.densities and not all(0.0 < d <= 0.3 for d in args.densities):
+            raise ConfigError("--densities: each must be in (0, 0.3]")
+        study = study_from_args(robots=args.robots, densities=args.densities, controllers=args.controllers,
+                                trials=args.trials, workers=args.workers, out=args.out, seed=args.seed,
+                                backend=args.backend)
+        out = run_study(study)
+        print(f"wrote {out / 'report.md'} and {out / 'results.csv'}")
+    elif args.study == "two-tier-astar":
+        from teamsim.tasks.studies.two_tier_astar import plan, run_study
+
+        written = run_study(plan(args.full, args.trials, args.seed), args.out, args.workers)
+        print(f"wrote {written['report']} and {written['results']} ({written['rows']} plans, "
+              f"{written['wall_s']:.0f} s)")
+    elif args.study == "awareness":
+        from teamsim.tasks.studies.awareness import AwarenessStudy, run_study
+
+        if args.duration is not None and not args.duration > 0:
+            raise ConfigError("--duration: must be > 0 simulated seconds")
+        out = run_study(AwarenessStudy(missions=args.missions, seed=args.seed, workers=args.workers, out=args.out,
+                                       duration=args.duration))
+        print(f"wrote {out / 'report.md'} and {out / 'results.csv'}")
+    elif args.study == "cleanup-faults":
+        from teamsim.tasks.studies.cleanup_faults import CleanupFaultStudy, run_study
+
+        out = run_study(CleanupFaultStudy(missions=args.missions, seed=args.seed, conditions=args.conditions,
+                                          workers=args.workers, out=args.out))
+        print(f"wrote {out / 'report.md'} and {out / 'results.csv'}")
+    elif args.study == "lalliance":
+        from teamsim.tasks.studies.lalliance import run_study
+
+        written = run_study(args.out, args.workers, full=args.full, runs=args.runs, seed=args.seed)
+        print(f"wrote {written['report']} and {written['results']} ({written['rows']} runs, "
+              f"{written['wall_s']:.0f} s)")
+    return 0
+
+
+def _trial_config(args) -> TrialConfig:
+    from teamsim.runner import mission_of
+    from teamsim.scenario import supports
+    from teamsim.cli.scenario import scenario_config
+
+    mission = mission_of(args.mission)
+    config = TrialConfig(mission=args.mission, params=mission.Params(), seed=args.seed or 0, duration=args.duration,
+                         out=args.out, run_id=args.run_id)
+    config.video.enabled = args.video
+    config.video.camera = args.camera
+    if args.scenario or supports(mission):
+        return scenario_config(args, mission, config)
+    for assignment in args.set:
+        apply_setting(config, assignment)
+    config.faults = [parse_fault(spec) for spec in args.fault]
+    validate(config)
+    return config
+
+
+def cmd_scenario(args) -> int:
+    from teamsim.runner import mission_of
+    from teamsim.scenario import not_supported, supports
+    from teamsim.cli.scenario import show
+
+    mission = mission_of(args.mission)
+    if not supports(mission):
+        raise not_supported(mission)
+    return show(args, mission, _trial_config(args))
+
+
+def cmd_run(args) -> int:
+    from teamsim.runner import run_trial
+
+    result = run_trial(_trial_config(args))
+    s = result.summary
+    print(f"{s['status']}: {result.run_dir} ({s['sim_time_s']:.1f} s simulated in {s['wall_time_s']:.1f} s, "
+          f"{s['real_time_factor']}x real time)")
+    if s.get("error"):
+        print(f"  {s['error']}", file=sys.stderr)
+    return {"completed": 0, "interrupted": 130}.get(result.status, 1)
+
+
+def cmd_list(_args) -> int:
+    from teamsim.models import ROBOT_BUILDERS, ROBOT_KINDS, build_robot
+    from teamsim.tasks import MISSIONS
+
+    print("robots:")
+    for kind in ROBOT_KINDS:
+        if kind not in ROBOT_BUILDERS:
+            print(f"  {kind:<10} (not built yet)")
+            continue
+        robot = build_robot(kind, "x")
+        sensors = [f"{len(robot.ir_sensors)} IR ({robot.ir.max_range:g} m)"]
+        sensors += [f"touch {name}" for name in robot.touch]
+        sensors += [f"{len(robot.beams)} break-beams"] if robot.beams else []
+        sensors += ["inclinometer"] if robot.inclinometer else []
+        print(f"  {kind:<10} {type(robot.drive).__name__.removesuffix('Spec').lower()} drive, "
+              f"v <= {robot.limits.v_max:g} m/s, traversability {robot.traversability:g}")
+        print(f"  {'':<10} sensors: {', '.join(sensors)}")
+        print(f"  {'':<10} actuators: {', '.join(robot.motors)}"
+              + "".join(f"; {name}: {', '.join(e.actuators)}" for name, e in robot.effectors.items()))
+    print("missions:")
+    for name, mission in MISSIONS.items():
+        print(f"  {name:<10} {mission.summary}")
+    print("studies:")
+    print("  navigation       Chand ch.3: FRC, HRDK, HRDU, ODW, ODWDS, RFRC x robots A, B, C x densities")
+    print("  two-tier-astar   Chand ch.4: memory-constrained two-tiered A* vs monolithic, no physics")
+    print("  lalliance        Parker §4.5: L-ALLIANCE strategies I-IV, abstract (no physics)")
+    print("  awareness        Parker ch.5: the cleanup with and without awareness, versions I-IV")
+    print("  cleanup-faults   Parker §3.8.4: the cleanup with red killed, the radio off, a gripper broken")
+    return 0
+
+
+def cmd_render(args) -> int:
+    from teamsim.rerender import rerender
+
+    out = rerender(args.run_dir, args.camera, args.out, args.width, args.height)
+    print(f"wrote {out}")
+    return 0
+
+
+def cmd_export(args) -> int:
+    from teamsim.cli.export import export_robot
+
+    export_robot(args.robot, args.out)
+    print(f"wrote {args.out}")
+    return 0
+
+
+def cmd_allocate(args) -> int:
+    from teamsim.cli.allocate import cmd_allocate as allocate
+
+    return allocate(args)
+
+
+def cmd_bench(args) -> int:
+    from teamsim.bench import physics as bench
+
+    if args.what == "allocate":
+        from teamsim.bench.allocate import bench_allocate
+
+        bench_allocate()
+        return 0
+    if args.what == "nav":
+        from teamsim.bench.nav import bench_nav
+
+        bench_nav()
+        return 0
+    if args.what == "alliance":
+        from teamsim.bench.alliance import bench_alliance
+
+        bench_alliance()
+        return 0
+    if args.what == "physics":
+        bench.physics(seconds=args.seconds or 10.0)
+        print()
+        bench.robot_kinds(seconds=args.seconds or 10.0)
+    elif args.what == "cleanup":
+        bench.cleanup(seconds=args.seconds or 300.0)
+    else:
+        bench.render(seconds=args.seconds or 4.0)
+    return 0
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = _build_parser()
+    try:
+        args = parser.parse_args(argv)
+        return {"run": cmd_run, "list": cmd_list, "render": cmd_render, "export": cmd_export,
+                "bench": cmd_bench, "study": cmd_study, "allocate": cmd_allocate,
+                "scenario": cmd_scenario}[args.command](args)
+    except (UsageError, ConfigError, RenderBackendError) as exc:
+        print(f"teamsim: error: {exc}", file=sys.stderr)
+        return EXIT_USAGE
+    except BrokenPipeError:  # the output went to a program that stopped reading (teamsim list | head)
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())  # no second error at interpreter exit
+        return 1
+

@@ -1,0 +1,102 @@
+"""The hazardous-waste studies' plumbing, without physics: which trials they run (faults, seeds, teams) and what
+their reports conclude from given rows. Their measured results are in docs/hazardous-waste.md."""
+from __future__ import annotations
+
+import csv
+
+import pytest
+
+from teamsim.cli.main import CLEANUP_CONDITIONS, main
+from teamsim.tasks.studies import awareness as aw
+from teamsim.tasks.studies import cleanup_faults as cf
+
+
+def test_cli_conditions_are_the_studys():
+    assert CLEANUP_CONDITIONS == cf.CONDITIONS
+
+
+def test_fault_study_runs_every_condition_on_the_same_seeds():
+    study = cf.CleanupFaultStudy(missions=4, seed=7)
+    configs = cf.trial_configs(study)
+    assert len(configs) == 4 * len(cf.CONDITIONS)
+    for condition in cf.CONDITIONS:
+        chosen = [c for c in configs if c.run_id.startswith(condition + "-")]
+        assert [c.seed for c in chosen] == [7, 8, 9, 10]
+        assert all(c.params.robots == 3 for c in chosen)
+    by_id = {c.run_id: c for c in configs}
+    assert by_id["none-0"].faults == []
+    assert {(f.kind, f.robot, f.time) for f in by_id["radio-off-2"].faults} == {
+        ("radio-off", name, 0.0) for name in ("red", "blue", "green")}
+    assert [(f.kind, f.robot, f.time) for f in by_id["break-gripper-1"].faults] == [("break-gripper", "green", 100.0)]
+
+
+def test_red_dies_at_a_reproducible_random_time_during_its_search():
+    study = cf.CleanupFaultStudy(missions=10)
+    times = [cf.faults_of(study, "kill-red", k)[1] for k in range(10)]
+    assert all(study.kill_window[0] <= t <= study.kill_window[1] for t in times)
+    assert len(set(times)) == 10  # a different moment in every mission
+    assert times == [cf.faults_of(study, "kill-red", k)[1] for k in range(10)]
+    assert times != [cf.faults_of(cf.CleanupFaultStudy(seed=1), "kill-red", k)[1] for k in range(10)]
+
+
+def row(condition, completed=True, **extra):
+    base = {"condition": condition, "mission": 0, "seed": 0, "fault_time": None, "status": "completed",
+            "completed": completed, "mission_time_s": 500.0, "energy_parker_units": 1000.0, "pucks_at_goal": 8,
+            "transports": 6, "reports": 1, "reporters": "blue", "find_robots": "red", "takeover": "",
+            "green_transports": 2, "green_move_spill_s": 300.0, "real_time_factor": 15.0}
+    return {**base, **extra}
+
+
+def test_fault_report_counts_each_conditions_finding(tmp_path):
+    study = cf.CleanupFaultStudy(missions=2, out=tmp_path)
+    rows = [row("none"), row("none", find_robots="red+green"),
+            row("kill-red", takeover="green", fault_time=40.0, find_robots="green+red"),
+            row("kill-red", completed=False, status="failed", pucks_at_goal=5, fault_time=60.0),
+            row("radio-off", find_robots="blue+green+red", reporters="blue+red"),
+            row("radio-off", find_robots="blue+green+red", reporters="red"),
+            row("break-gripper", fault_time=100.0, green_move_spill_s=120.0),
+            row("break-gripper", fault_time=100.0, green_move_spill_s=80.0)]
+    text = cf.report(study, rows)
+    assert "| none | 2/2 |" in text and "red alone searched in 1/2" in text
+    assert "| kill-red | 1/2 |" in text and "took the search over (find-locations-wander) in 1/2" in text
+    assert "every robot searched for itself in 2/2; more than one robot reported in 1/2" in text
+    assert "mean 100 s, max 120 s (gripper broken at 100 s)" in text
+    assert "kill-red seed 0 (failed, 5 pucks)" in text
+
+
+def test_awareness_versions_and_their_claims():
+    configs = aw.trial_configs(aw.AwarenessStudy(missions=3))
+    assert len(configs) == 12
+    version_iv = [c for c in configs if c.run_id.startswith("IV-")]
+    assert all(len(c.faults) == 3 and {f.kind for f in c.faults} == {"radio-off"} for c in version_iv)
+    assert all(c.faults == [] for c in configs if c.run_id.startswith("II-"))
+
+    def mission(version, time, energy, reports, transports, find):
+        robots, aware = aw.VERSIONS[version]
+        return {"version": version, "robots": robots, "awareness": aware, "completed": True, "status": "completed",
+                "mission_time_s": time, "energy_parker_units": energy, "pucks_at_goal": 8, "transports": transports,
+                "reports": reports, "find_robots": find}
+
+    rows = [mission("I", 900, 1200, 3, 6, 1), mission("II", 600, 1300, 2, 6, 1),
+            mission("III", 1000, 1400, 5, 6, 2), mission("IV", 650, 1900, 4, 6, 3)]
+    verdicts = {claim: agrees for claim, _, _, agrees in aw.claims(rows)}
+    assert verdicts["energy: IV is the worst version"] is True
+    assert verdicts["time: III (2 robots, no awareness) is the slowest"] is True
+    assert verdicts["time: three robots beat two, even IV against I"] is True
+    rows[3]["energy_parker_units"] = 1000  # IV now the cheapest: the claim must fail
+    verdicts = {claim: agrees for claim, _, _, agrees in aw.claims(rows)}
+    assert verdicts["energy: IV is the worst version"] is False
+
+
+def test_bad_conditions_are_refused(capsys):
+    assert main(["study", "cleanup-faults", "--conditions", "kill-red,melt"]) == 2
+    assert "condition 'melt' not allowed; allowed: none, kill-red, radio-off, break-gripper" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("columns", [cf.COLUMNS, aw.COLUMNS])
+def test_results_tables_have_their_columns(tmp_path, columns):
+    from teamsim.files import write_csv
+
+    write_csv(tmp_path / "r.csv", columns, [dict.fromkeys(columns, 1)])
+    with open(tmp_path / "r.csv", newline="") as handle:
+        assert tuple(csv.DictReader(handle).fieldnames) == tuple(columns)
