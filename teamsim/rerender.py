@@ -1,6 +1,10 @@
-"""``teamsim render RUN_DIR``: a video from ``trajectory.npz`` alone, through the live render's own path."""
+"""``teamsim render RUN_DIR...``: a video from ``trajectory.npz`` alone, through the live render's own path;
+several runs at once in parallel worker processes, one core each."""
 from __future__ import annotations
 
+import concurrent.futures as futures
+import multiprocessing
+import os
 from pathlib import Path
 
 from teamsim.config import ConfigError
@@ -8,11 +12,16 @@ from teamsim.progress import Progress
 from teamsim.recording import load_trajectory
 
 
-def rerender(run_dir: Path, camera: str = "top", out: Path | None = None, width: int = 640,
-             height: int = 480) -> Path:
-    trajectory_path = Path(run_dir) / "trajectory.npz"
-    if not trajectory_path.is_file():
+def trajectory_of(run_dir: Path) -> Path:
+    path = Path(run_dir) / "trajectory.npz"
+    if not path.is_file():
         raise ConfigError(f"RUN_DIR {run_dir}: no trajectory.npz there")
+    return path
+
+
+def rerender(run_dir: Path, camera: str = "top", out: Path | None = None, width: int = 640,
+             height: int = 480, progress: bool | None = None) -> Path:
+    trajectory_path = trajectory_of(run_dir)
     from teamsim.video import FrameRenderer, Mp4Writer, camera_name
 
     t = load_trajectory(trajectory_path)
@@ -23,7 +32,7 @@ def rerender(run_dir: Path, camera: str = "top", out: Path | None = None, width:
         raise ConfigError(f"--camera: {exc}") from None
     out = Path(out) if out else Path(run_dir) / f"video-{camera_name(camera).replace('/', '-')}.mp4"
     writer = Mp4Writer(out, width, height, int(t["fps"]))
-    bar = Progress(float(t["time"][-1]) if len(t["time"]) else 0.0, f"render {camera}")
+    bar = Progress(float(t["time"][-1]) if len(t["time"]) else 0.0, f"render {camera}", enabled=progress)
     try:
         for time, qpos, behaviours in zip(t["time"], t["qpos"], t["behaviour"]):
             writer.write(renderer.render(float(time), qpos, [str(b) for b in behaviours]))
@@ -33,3 +42,22 @@ def rerender(run_dir: Path, camera: str = "top", out: Path | None = None, width:
         writer.close()
         renderer.close()
     return out
+
+
+def rerender_all(run_dirs: list[Path], camera: str = "top", width: int = 640, height: int = 480,
+                 workers: int | None = None) -> list[Path]:
+    """Each run's video (as ``rerender``), ``workers`` at a time (default: one per core), in order."""
+    for run_dir in run_dirs:
+        trajectory_of(run_dir)  # every bad RUN_DIR is named before any work starts
+    workers = min(len(run_dirs), workers or os.cpu_count() or 1)
+    if workers == 1:
+        return [rerender(run_dir, camera, None, width, height) for run_dir in run_dirs]
+    bar = Progress(len(run_dirs), f"render {len(run_dirs)} runs on {workers} workers", unit="runs done")
+    context = multiprocessing.get_context("spawn")  # a GL context does not survive a fork
+    with futures.ProcessPoolExecutor(max_workers=workers, mp_context=context) as pool:
+        jobs = [pool.submit(rerender, run_dir, camera, None, width, height, False) for run_dir in run_dirs]
+        for done, _ in enumerate(futures.as_completed(jobs), start=1):
+            bar.update(done)
+        outs = [job.result() for job in jobs]
+    bar.finish()
+    return outs

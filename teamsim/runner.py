@@ -105,12 +105,11 @@ def run_trial(config: TrialConfig, seed: int | None = None, progress: bool | Non
     config = resolve(config, mission)  # the mission's world as a scenario, if it describes its worlds so
     duration = config.duration or mission.default_duration
     world = World(config, mission)
-    renderer = writer = None
+    video = None
     if config.video.enabled:
-        from teamsim.video import FrameRenderer, Mp4Writer  # imports GL only when a video is asked for
+        from teamsim.video import VideoProcess, camera_id  # imports GL only when a video is asked for
         try:
-            renderer = FrameRenderer(world.xml, list(world.robots), config.video.width, config.video.height,
-                                     config.video.camera)
+            camera_id(world.model, config.video.camera)
         except ValueError as exc:
             raise ConfigError(f"video.camera: {exc}") from None
     run_dir = make_run_dir(config)
@@ -126,8 +125,9 @@ def run_trial(config: TrialConfig, seed: int | None = None, progress: bool | Non
     world.record_trace = motivation
     speedup = config.video.speedup or getattr(mission, "video_speedup", 1.0)
     recorder = TrajectoryRecorder(world.xml, list(world.robots), config.video.fps, world.physics_dt, speedup)
-    if renderer is not None:
-        writer = Mp4Writer(run_dir / "video.mp4", config.video.width, config.video.height, config.video.fps)
+    if config.video.enabled:
+        video = VideoProcess(run_dir / "video.mp4", world.xml, list(world.robots), config.video.width,
+                             config.video.height, config.video.camera, config.video.fps)
     bar = Progress(duration, f"{config.mission} seed {config.seed}", enabled=progress)
     events({"t": 0.0, "event": "trial_start", "mission": config.mission, "seed": config.seed,
             "robots": list(world.robots)})
@@ -136,8 +136,8 @@ def run_trial(config: TrialConfig, seed: int | None = None, progress: bool | Non
         behaviours = [r.behaviour if r.active else ("dead" if not r.health.alive else "absent")
                       for r in world.robots.values()]
         recorder.capture(world.time, world.data.qpos, behaviours)
-        if writer is not None:
-            writer.write(renderer.render(world.time, world.data.qpos, behaviours))
+        if video is not None:
+            video.write(world.time, world.data.qpos, behaviours)
 
     status, error, completed, metrics = "running", None, False, {}
     started = time.perf_counter()
@@ -162,9 +162,9 @@ def run_trial(config: TrialConfig, seed: int | None = None, progress: bool | Non
         if recorder.times:
             write_timeline(run_dir / "timeline.png", recorder.times, recorder.behaviour_array(), recorder.robot_names,
                            [f.describe() for f in config.faults], motivation.series)
-        if writer is not None:
-            writer.close()
-            renderer.close()
+        video_failure = video.close() if video is not None else None
+        if video_failure:
+            error = f"{error}; video: {video_failure}" if error else f"video: {video_failure}"
         wall = time.perf_counter() - started
         summary.update(status=status, completed=status == "completed", error=error,
                        sim_time_s=round(world.time, 6), wall_time_s=round(wall, 3),

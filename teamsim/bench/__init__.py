@@ -1,2 +1,2 @@
 """``teamsim bench ...``: figures and ratios measured in one run (physics, cleanup, render, nav, alliance,
-allocate)."""
+allocate, sweep)."""

@@ -48,10 +48,13 @@ def _build_parser() -> argparse.ArgumentParser:
     show.add_argument("--output", type=Path, metavar="FILE", help="write it to FILE instead")
     show.set_defaults(video=False, camera="top", out="renders", run_id=None)
 
-    render = commands.add_parser("render", help="re-render a run's video from its trajectory.npz")
-    render.add_argument("run_dir", type=Path)
+    render = commands.add_parser("render", help="re-render runs' videos from their trajectory.npz, several in "
+                                                "parallel")
+    render.add_argument("run_dirs", type=Path, nargs="+", metavar="RUN_DIR")
+    render.add_argument("--workers", type=_positive_int("--workers"), help="runs rendered at once (default: one "
+                                                                          "per core)")
     render.add_argument("--camera", default="top")
-    render.add_argument("--out", type=Path, help="video path (default: RUN_DIR/video-CAMERA.mp4)")
+    render.add_argument("--out", type=Path, help="video path, with one RUN_DIR (default: RUN_DIR/video-CAMERA.mp4)")
     render.add_argument("--width", type=int, default=640)
     render.add_argument("--height", type=int, default=480)
 
@@ -108,7 +111,7 @@ def _build_parser() -> argparse.ArgumentParser:
     faults.add_argument("--out", type=Path, default=Path("renders/study-cleanup-faults"))
 
     bench = commands.add_parser("bench", help="benchmarks")
-    bench.add_argument("what", choices=("physics", "cleanup", "render", "nav", "alliance", "allocate"))
+    bench.add_argument("what", choices=("physics", "cleanup", "render", "nav", "alliance", "allocate", "sweep"))
     bench.add_argument("--seconds", type=float, default=None, help="simulated seconds per measurement")
     return parser
 
@@ -271,10 +274,16 @@ def cmd_list(_args) -> int:
 
 
 def cmd_render(args) -> int:
-    from teamsim.rerender import rerender
+    from teamsim.rerender import rerender, rerender_all
 
-    out = rerender(args.run_dir, args.camera, args.out, args.width, args.height)
-    print(f"wrote {out}")
+    if args.out is not None and len(args.run_dirs) > 1:
+        raise UsageError(f"--out names one video; got {len(args.run_dirs)} RUN_DIRs (leave --out out)")
+    if args.out is not None:
+        outs = [rerender(args.run_dirs[0], args.camera, args.out, args.width, args.height)]
+    else:
+        outs = rerender_all(args.run_dirs, args.camera, args.width, args.height, args.workers)
+    for out in outs:
+        print(f"wrote {out}")
     return 0
 
 
@@ -305,6 +314,11 @@ def cmd_bench(args) -> int:
 
         bench_nav()
         return 0
+    if args.what == "sweep":
+        from teamsim.bench.sweep import bench_sweep
+
+        bench_sweep()
+        return 0
     if args.what == "alliance":
         from teamsim.bench.alliance import bench_alliance
 
@@ -317,7 +331,11 @@ def cmd_bench(args) -> int:
     elif args.what == "cleanup":
         bench.cleanup(seconds=args.seconds or 300.0)
     else:
+        from teamsim.bench.video import video_cost
+
         bench.render(seconds=args.seconds or 4.0)
+        print()
+        video_cost()
     return 0
 
 

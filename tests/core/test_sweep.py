@@ -26,3 +26,26 @@ def test_process_pool_matches_serial_runs(tmp_path):
 def test_unknown_backend(tmp_path):
     with pytest.raises(ValueError, match="allowed: process, ray"):
         run_trials([wander_config(tmp_path)], backend="dask")
+
+
+def _without_timing(summary: dict) -> dict:
+    """A summary less what depends on the machine and the output folder."""
+    return {k: v for k, v in summary.items() if k not in ("wall_time_s", "real_time_factor", "config")}
+
+
+def test_ray_backend_matches_the_process_pool(tmp_path):
+    """The same two-trial sweep on a local Ray instance and on the process pool: the same summaries and events."""
+    ray = pytest.importorskip("ray")
+    configs = {where: [wander_config(tmp_path / where, params={"robots": 2}, seed=s, duration=2.0, run_id=f"s{s}")
+                       for s in (4, 5)] for where in ("ray", "pool")}
+    ray.init(num_cpus=2, include_dashboard=False, log_to_driver=False)
+    try:
+        on_ray = run_trials(configs["ray"], backend="ray")
+    finally:
+        ray.shutdown()
+    pooled = run_trials(configs["pool"], workers=2)
+    assert [s["status"] for s in on_ray] == ["completed", "completed"]
+    assert [_without_timing(s) for s in on_ray] == [_without_timing(s) for s in pooled]
+    for seed in (4, 5):
+        assert ((tmp_path / "ray" / "wander" / f"s{seed}" / "events.jsonl").read_bytes()
+                == (tmp_path / "pool" / "wander" / f"s{seed}" / "events.jsonl").read_bytes())
