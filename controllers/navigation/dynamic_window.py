@@ -109,6 +109,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from teamsim.controllers.base import Command, Observation
+from teamsim.controllers.navigation import dwa_kernels as kernels
 from teamsim.controllers.navigation.astar import PlannerParams, WeightAdaptation, adapt_weights, plan_on_grid
 from teamsim.controllers.navigation.occupancy_grid import OccupancyGrid
 from teamsim.controllers.navigation.polar_histogram import (DirectionSensorParams, modified_target_heading,
@@ -311,7 +312,7 @@ class DynamicWindow:
         speed_up, slow_down = min(p.a_a, a_lim) * self.dt, min(-p.a_d, a_lim) * self.dt
         lo = v_c - (slow_down if v_c > 0 else speed_up)
         hi = v_c + (slow_down if v_c < 0 else speed_up)
-        return float(np.clip(v_min, lo, hi)), float(np.clip(v_max, lo, hi))
+        return _clip(v_min, lo, hi), _clip(v_max, lo, hi)
 
     def curvature_limits(self, steer: float) -> tuple[float, float]:
         """Tricycle: [c_min, c_max] over the steering angles reachable this cycle."""
@@ -334,7 +335,7 @@ class DynamicWindow:
         hi = min(state.omega + step, self.limits.omega_max)
         lo, hi = max(w_min, lo), min(w_max, hi)
         if lo > hi:  # omega_c lies outside what the drive allows next cycle: get as close as it can
-            lo = hi = float(np.clip(0.0, state.omega - step, state.omega + step))
+            lo = hi = _clip(0.0, state.omega - step, state.omega + step)
         return lo, hi, alpha_min
 
     # ------------------------------------------------------------------ geometry
@@ -353,38 +354,9 @@ class DynamicWindow:
         it). Given DC_cdmax instead, near obstacles it escapes the alpha_3 scaling of (3.35) that every moving
         candidate gets there, outscores them all, and a robot at rest stays at rest for good: the deadlock at
         zero velocity that CC4 (3.31) is there to prevent."""
-        p = self.params
-        r = self.radius + margin
-        distance = np.hypot(points[:, 0], points[:, 1])
-        kept = float(np.clip(distance.min() - r, 0.0, p.dc_max)) if points.shape[0] else p.dc_max
-        turning = np.abs(omega) > 1e-9
-        moving = ~self.in_place(v, omega)
-        outside = distance >= self.radius
-        pts = points[outside]
-        if pts.shape[0] == 0:
-            return np.where(moving, p.dc_max, kept)
-        r = np.where(distance[outside] >= r, r, self.radius)[None, :]  # per point: see above
-        px, py = pts[:, 0][None, :], pts[:, 1][None, :]
-        # Straight: travel along +-x until a point enters the circle.
-        forward = np.sign(v)[:, None]
-        ahead = forward * px
-        straight_hit = (ahead > 0) & (np.abs(py) < r)
-        straight = np.where(straight_hit, ahead - np.sqrt(np.maximum(r * r - py * py, 0.0)), np.inf)
-        # Arcs: the centre circles the instantaneous centre of rotation I = (-offset, v/omega) at radius rho (3.11).
-        safe_omega = np.where(turning, omega, 1.0)
-        icr_y = (v / safe_omega)[:, None]
-        rho = np.hypot(self.offset, icr_y)
-        qx, qy = px + self.offset, py - icr_y
-        d = np.hypot(qx, qy)
-        centre_angle = np.arctan2(-icr_y, self.offset)
-        swept = np.sign(safe_omega)[:, None] * (np.arctan2(qy, qx) - centre_angle)
-        ahead_angle = np.mod(swept, 2 * np.pi)
-        cos_touch = (rho ** 2 + d ** 2 - r * r) / np.maximum(2 * rho * d, 1e-12)
-        touch = np.arccos(np.clip(cos_touch, -1.0, 1.0))
-        arc_hit = np.abs(d - rho) < r
-        arc = np.where(arc_hit, rho * np.maximum(ahead_angle - touch, 0.0), np.inf)
-        travel = np.where(turning[:, None], arc, straight).min(axis=1)
-        return np.where(moving, np.minimum(travel, p.dc_max), kept)
+        x, y = _columns(points)
+        return kernels.collision_distances(_floats(v), _floats(omega), x, y, self.radius, margin, self.offset,
+                                           self.params.dc_max)
 
     def in_place(self, v: np.ndarray, omega: np.ndarray) -> np.ndarray:
         """Candidates that leave the robot's centre where it is: a stop, and a point turn about the centre
@@ -404,7 +376,7 @@ class DynamicWindow:
         if pts.shape[0] == 0 or v.size == 0:
             return np.ones(v.size, bool)
         radii = np.where(distance >= r, r, self.radius)
-        speed, w = np.abs(v), omega
+        speed = np.abs(v)
         brake = min(p.a_a, lim.accel_max)
         # Only points the enlarged circle can reach: the centre moves at most the reference point's stopping
         # path plus twice the offset (the centre swung round to the reference point's other side).
@@ -413,36 +385,9 @@ class DynamicWindow:
         pts, radii = pts[reachable], radii[reachable]
         if pts.shape[0] == 0:
             return np.ones(v.size, bool)
-        moving = speed > 1e-9
-        curvature = np.where(moving, omega / np.where(moving, v, 1.0), 0.0)
-        direction = np.sign(v)
-        # Speed and turn rate at each step's end: the held cycle, then braking two cycles a step until every
-        # candidate has stopped (the turn rate of a slower one keeps settling meanwhile). The circle's positions
-        # stay a few centimetres apart, which cannot miss a point at these radii.
-        speeds, rates = [speed, speed], [w, w]
-        turn = lim.angular_accel_max * 2 * self.dt
-        while True:
-            speed = np.maximum(speed - brake * 2 * self.dt, 0.0)
-            w = np.minimum(np.maximum(curvature * direction * speed, w - turn), w + turn)  # np.clip, faster
-            speeds.append(speed)
-            rates.append(w)
-            if not speed.any():
-                break
-        speeds, rates = np.array(speeds), np.array(rates)  # (steps + 1, candidates)
-        dt = np.full((len(speeds) - 1, 1), 2 * self.dt)
-        dt[0] = self.dt
-        # Every step at once, each at its mean speed and turn rate (running sums, as stepping one by one).
-        step = direction * (speeds[:-1] + speeds[1:]) / 2 * dt
-        mean_w = (rates[:-1] + rates[1:]) / 2
-        th = np.cumsum(mean_w * dt, axis=0)
-        mid = np.vstack([np.zeros((1, v.size)), th[:-1]]) + mean_w * dt / 2
-        x, y = np.cumsum(step * np.cos(mid), axis=0), np.cumsum(step * np.sin(mid), axis=0)
-        # The centre, ``offset`` ahead of the reference point, relative to where the centre started.
-        centres = np.stack([x + self.offset * (np.cos(th) - 1.0), y + self.offset * np.sin(th)], axis=-1)
-        # |p - c|^2 < r^2 as c.p - |c|^2/2 > (|p|^2 - r^2)/2: one matrix product over every step, candidate and
-        # point.
-        closeness = centres @ pts.T - (centres ** 2).sum(axis=-1, keepdims=True) / 2
-        return ~(closeness > ((pts ** 2).sum(axis=1) - radii ** 2) / 2).any(axis=(0, 2))
+        x, y = _columns(pts)
+        return kernels.stops_clear(_floats(v), _floats(omega), x, y, radii, self.offset, self.dt, brake,
+                                   lim.angular_accel_max * 2 * self.dt)
 
     def towards(self, v: np.ndarray, omega: np.ndarray, points: np.ndarray) -> np.ndarray:
         """For each candidate, whether the centre moves towards any of ``points``: one of them lies ahead along the
@@ -483,9 +428,9 @@ class DynamicWindow:
         w_lo, w_hi, alpha_min = self.angular_window(state, v_window)
         v_samples = _samples(*v_window, p.n_vd)
         w_samples = _samples(w_lo, w_hi, p.n_wd)
-        v, omega = (a.ravel() for a in np.meshgrid(v_samples, w_samples, indexing="ij"))
+        v, omega = np.repeat(v_samples, w_samples.size), np.tile(w_samples, v_samples.size)  # every pair
         v_brake, w_brake = self._braking_continuation(state, v_window, (w_lo, w_hi))
-        v, omega = np.append(v, v_brake), np.append(omega, w_brake)
+        v, omega = np.concatenate((v, [v_brake])), np.concatenate((omega, [w_brake]))
 
         # Safety margin (3.26)-(3.27): no candidate may move the centre towards an obstacle inside it.
         margin = p.sm_min + p.k_sm * abs(state.v)
@@ -560,10 +505,10 @@ class DynamicWindow:
         windows."""
         brake = min(self.params.a_a, self.limits.accel_max) * self.dt
         turn = self.limits.angular_accel_max * self.dt
-        v = float(np.clip(np.sign(state.v) * max(abs(state.v) - brake, 0.0), *v_window))
+        v = _clip(float(np.sign(state.v)) * max(abs(state.v) - brake, 0.0), *v_window)
         curvature = state.omega / state.v if abs(state.v) > 1e-9 else 0.0
-        omega = float(np.clip(curvature * v, state.omega - turn, state.omega + turn))
-        return v, float(np.clip(omega, *w_window))
+        omega = _clip(curvature * v, state.omega - turn, state.omega + turn)
+        return v, _clip(omega, *w_window)
 
     def _curvature_checks(self, state: DriveState, v: np.ndarray, omega: np.ndarray, points: np.ndarray,
                           distance: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -611,18 +556,33 @@ class DynamicWindow:
 
     def _brake(self, state: DriveState, v_window, w_window, v_min: float) -> Decision:
         """The reachable velocity nearest a standstill; a tricycle keeps its steering angle."""
-        v = float(np.clip(0.0, *v_window))
+        v = _clip(0.0, *v_window)
         if self.tricycle:
             omega = tricycle_turn(v, math.tan(state.steer) / self.steering.wheelbase, w_window)
         else:
-            omega = float(np.clip(0.0, *w_window))
+            omega = _clip(0.0, *w_window)
         return Decision(v, omega, "brake", INVALID, v_min)
 
 
 def tricycle_turn(v: float, curvature: float, w_window: tuple[float, float]) -> float:
     """A tricycle's turn rate at speed ``v`` along ``curvature``, within the angular window; none standing, whatever
     the window (it has no point turns, and a turn-only command would turn its wheel instead)."""
-    return float(np.clip(v * curvature, *w_window)) if v else 0.0
+    return _clip(v * curvature, *w_window) if v else 0.0
+
+
+def _clip(x: float, lo: float, hi: float) -> float:
+    """np.clip of one number (the same value; numpy's call costs more than the arithmetic)."""
+    return float(min(max(x, lo), hi))
+
+
+def _floats(a) -> np.ndarray:
+    return np.ascontiguousarray(a, dtype=float)
+
+
+def _columns(points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """x and y of (m, 2) points as contiguous arrays, as the compiled kernels take them."""
+    points = np.asarray(points, float).reshape(-1, 2)
+    return np.ascontiguousarray(points[:, 0]), np.ascontiguousarray(points[:, 1])
 
 
 def _samples(lo: float, hi: float, count: int) -> np.ndarray:

@@ -9,12 +9,13 @@ too.
 
 Dynamic window: the wall time of each controller call (direction sensor, dynamic window, obstacle memory: one
 control tick of one robot) of FRC driving Chand's Robot A (tricycle) and Robot B (differential) across random
-worlds without physics (``teamsim.tasks.worlds.navigation.kinematic_run``). Target: 2 ms a call. The inputs of every
-dynamic-window decision of those runs are recorded and replayed, call by call in turn, through a fresh
-``DynamicWindow.decide`` (numpy over all candidates at once) and the plain ``reference_decide``
-(``teamsim.controllers.navigation.reference_dwa``: Python loops over the candidates and the obstacle points), which
-evaluates the same window, candidates and objectives and must choose the same (v, omega): the ratio of their mean times
-is the implementation's alone. It covers the dynamic-window stage, not the direction sensor or obstacle memory.
+worlds without physics (``teamsim.tasks.worlds.navigation.kinematic_run``). Target (issue 21): a mean of 0.3 ms
+and a p99 of 1 ms a call. The inputs of every dynamic-window decision of those runs are recorded and replayed,
+call by call in turn, through a fresh ``DynamicWindow.decide`` (numpy over all candidates, the two innermost
+loops compiled) and the plain ``reference_decide`` (``teamsim.controllers.navigation.reference_dwa``: Python
+loops over the candidates and the obstacle points), which evaluates the same window, candidates and objectives
+and must choose the same (v, omega): the ratio of their mean times is the implementation's alone. It covers the
+dynamic-window stage, not the direction sensor or obstacle memory.
 """
 from __future__ import annotations
 
@@ -29,7 +30,7 @@ from teamsim.controllers.navigation.reference_dwa import reference_decide
 from teamsim.models.robot import DriveLimits
 from teamsim.tasks.worlds.navigation import KinematicRobot, kinematic_run, random_world
 
-DECISION_TARGET = 2e-3  # s per controller call
+DECISION_TARGET_MEAN, DECISION_TARGET_P99 = 0.3e-3, 1e-3  # s per controller call
 # Chand's Table 3.1 robots A and B with Scratchy's measured accelerations (Table 3.4).
 LIMITS = DriveLimits(v_max=0.5, omega_max=math.pi / 7, accel_max=0.1, angular_accel_max=0.15)
 ROBOTS = {
@@ -126,10 +127,12 @@ def run(grid_size: int = 1000, grid_density: float = 0.2, seed: int = 0, world_d
     print(f"  modified A*, thesis Manhattan (heap)   {a['thesis_heuristic_s']:8.2f} s  ({a['thesis_expanded']} "
           f"expanded, path cost +{a['thesis_cost_excess']:.1%})", flush=True)
     print(f"bench nav: FRC decision per control tick per robot, {worlds} worlds at {world_density:.0%}, "
-          f"up to {duration:g} s each, target <= {DECISION_TARGET * 1e3:g} ms")
+          f"up to {duration:g} s each, target mean <= {DECISION_TARGET_MEAN * 1e3:g} ms, "
+          f"p99 <= {DECISION_TARGET_P99 * 1e3:g} ms")
     decisions = time_decisions(world_density, worlds, duration)
     for name, row in decisions.items():
-        verdict = "ok" if row["mean_ms"] <= DECISION_TARGET * 1e3 else "OVER TARGET"
+        on_target = row["mean_ms"] <= DECISION_TARGET_MEAN * 1e3 and row["p99_ms"] <= DECISION_TARGET_P99 * 1e3
+        verdict = "ok" if on_target else "OVER TARGET"
         print(f"  {name:<17} mean {row['mean_ms']:5.2f} ms  median {row['median_ms']:5.2f} ms  "
               f"p99 {row['p99_ms']:5.2f} ms  over {row['calls']} calls  {verdict}")
     print("bench nav: the dynamic window's decision alone, FRC (DynamicWindow.decide) against the plain "

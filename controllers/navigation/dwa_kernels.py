@@ -1,0 +1,121 @@
+"""The dynamic window's two innermost loops, compiled (numba): every candidate against every obstacle point.
+
+- :func:`collision_distances`: DC_cd of §3.5, how far the centre travels along each candidate's arc (3.11)
+  before the robot's circle touches a point, capped at DC_cdmax;
+- :func:`stops_clear`: ST_v (3.33) by integration, whether the robot, holding a candidate one cycle and then
+  braking along its curvature, keeps its circle clear of every point.
+
+They are :class:`~teamsim.controllers.navigation.dynamic_window.DynamicWindow`'s methods of the same names, whose
+docstrings give the reasoning; here the same arithmetic runs as plain loops, one candidate and one point at a
+time, and a candidate stops at the first point that settles it. Vectorised numpy spent most of a decision
+creating arrays for a few thousand pairs (docs/decisions.md, "Navigation decisions compiled").
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+STILL = 1e-9  # |v| or |omega| at or below this is zero
+
+
+@njit("b1(f8, f8, f8)", cache=True)
+def in_place(v: float, omega: float, offset: float) -> bool:
+    return abs(v) <= STILL and (abs(omega) <= STILL or abs(offset) <= STILL)
+
+
+@njit("f8[::1](f8[::1], f8[::1], f8[::1], f8[::1], f8, f8, f8, f8)", cache=True)
+def collision_distances(v, omega, px, py, radius, margin, offset, dc_max):  # noqa: PLR0913
+    """DC_cd per candidate (v[k], omega[k]) for points (px, py) in the robot frame, centre at the origin."""
+    enlarged = radius + margin
+    n = v.shape[0]
+    distance = np.hypot(px, py)
+    kept = min(max(distance.min() - enlarged, 0.0), dc_max) if px.shape[0] else dc_max
+    # The points outside the robot's circle, nearest first: a point at distance d cannot be touched before the
+    # centre has travelled d - r, so the search along a candidate ends at the first point beyond its best.
+    order = np.argsort(distance)
+    order = order[distance[order] >= radius]
+    out = np.empty(n)
+    for k in range(n):
+        if in_place(v[k], omega[k], offset):
+            out[k] = kept
+            continue
+        travel = dc_max
+        turning = abs(omega[k]) > STILL
+        if turning:
+            icr_y = v[k] / omega[k]
+            rho = math.hypot(offset, icr_y)
+            centre_angle = math.atan2(-icr_y, offset)
+            turn = 1.0 if omega[k] > 0 else -1.0
+        else:
+            forward = np.sign(v[k])
+        for j in order:
+            if distance[j] - enlarged >= travel:
+                break
+            r = enlarged if distance[j] >= enlarged else radius
+            if turning:
+                qx, qy = px[j] + offset, py[j] - icr_y
+                d = math.hypot(qx, qy)
+                if abs(d - rho) < r:
+                    ahead = np.mod(turn * (math.atan2(qy, qx) - centre_angle), 2 * np.pi)
+                    cos_touch = (rho ** 2 + d ** 2 - r * r) / max(2 * rho * d, 1e-12)
+                    touch = math.acos(min(max(cos_touch, -1.0), 1.0))
+                    travel = min(travel, rho * max(ahead - touch, 0.0))
+            else:
+                ahead = forward * px[j]
+                if ahead > 0 and abs(py[j]) < r:
+                    travel = min(travel, ahead - math.sqrt(max(r * r - py[j] * py[j], 0.0)))
+        out[k] = travel
+    return out
+
+
+@njit("b1[::1](f8[::1], f8[::1], f8[::1], f8[::1], f8[::1], f8, f8, f8, f8)", cache=True)
+def stops_clear(v, omega, px, py, radii, offset, dt, brake, turn):  # noqa: PLR0913
+    """ST_v per candidate: the centre's path, one cycle at (v, omega) then braking at ``brake`` two cycles a step
+    (the turn rate following the curvature, changing at most ``turn`` a step), clear of every point (px, py),
+    each by its own radius."""
+    n, m = v.shape[0], px.shape[0]
+    top = 0.0
+    for k in range(n):
+        top = max(top, abs(v[k]))
+    steps = 1  # the held cycle; then braking until the fastest candidate has stopped
+    speed = top
+    while True:
+        speed = max(speed - brake * 2 * dt, 0.0)
+        steps += 1
+        if speed == 0.0:
+            break
+    threshold = np.empty(m)
+    for j in range(m):
+        threshold[j] = (px[j] ** 2 + py[j] ** 2 - radii[j] ** 2) / 2
+    clear = np.ones(n, np.bool_)
+    for k in range(n):
+        speed_now, w_now = abs(v[k]), omega[k]
+        moving = speed_now > STILL
+        curvature = omega[k] / v[k] if moving else 0.0
+        direction = np.sign(v[k])
+        th = x = y = 0.0
+        for s in range(steps):
+            if s == 0:
+                speed_next, w_next, step_dt = speed_now, w_now, dt
+            else:
+                speed_next = max(speed_now - brake * 2 * dt, 0.0)
+                w_next = min(max(curvature * direction * speed_next, w_now - turn), w_now + turn)
+                step_dt = 2 * dt
+            step = direction * (speed_now + speed_next) / 2 * step_dt
+            mean_w = (w_now + w_next) / 2
+            mid = th + mean_w * step_dt / 2
+            th += mean_w * step_dt
+            x += step * math.cos(mid)
+            y += step * math.sin(mid)
+            cx, cy = x + offset * (math.cos(th) - 1.0), y + offset * math.sin(th)
+            half_c2 = (cx ** 2 + cy ** 2) / 2
+            for j in range(m):
+                if cx * px[j] + cy * py[j] - half_c2 > threshold[j]:
+                    clear[k] = False
+                    break
+            if not clear[k]:
+                break
+            speed_now, w_now = speed_next, w_next
+    return clear

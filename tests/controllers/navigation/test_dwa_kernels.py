@@ -1,0 +1,59 @@
+"""The dynamic window's compiled loops (dwa_kernels, through DynamicWindow's methods) against the plain Python
+loops of reference_dwa, one candidate at a time, on random scenes: the same DC_cd and the same ST_v."""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from teamsim.controllers.navigation.dynamic_window import DynamicWindow
+from teamsim.controllers.navigation.reference_dwa import _braking_steps, _collision_distance, _stops_clear
+from teamsim.models.robot import DriveLimits
+
+LIMITS = DriveLimits(v_max=0.5, omega_max=math.pi / 7, accel_max=0.1, angular_accel_max=0.15)
+WINDOWS = {"differential": DynamicWindow(LIMITS, "diffdrive", 0.35),
+           "tricycle": DynamicWindow(LIMITS, "tricycle", 0.5, centre_offset=0.25)}
+
+
+def scene(rng: np.random.Generator):
+    v = rng.uniform(-0.3, 0.5, 56)
+    omega = rng.uniform(-0.45, 0.45, 56)
+    v[:5], omega[5:10] = 0.0, 0.0  # point turns, stops and straight lines too
+    points = rng.uniform(-3.0, 3.0, (rng.integers(0, 150), 2))
+    return v, omega, points, float(rng.uniform(0.0, 0.2))
+
+
+@pytest.mark.parametrize("form", WINDOWS)
+def test_collision_distances_match_the_reference(form):
+    window, rng = WINDOWS[form], np.random.default_rng(11)
+    for _ in range(100):
+        v, omega, points, margin = scene(rng)
+        r = window.radius + margin
+        dist = np.hypot(points[:, 0], points[:, 1])
+        kept = float(np.clip(dist.min() - r, 0.0, window.params.dc_max)) if len(points) else window.params.dc_max
+        outside = [(x, y, d) for (x, y), d in zip(points, dist) if d >= window.radius]
+        expected = [_collision_distance(a, w, outside, r, window.offset, kept, window.params.dc_max, window.radius)
+                    for a, w in zip(v, omega)]
+        np.testing.assert_allclose(window.collision_distances(v, omega, points, margin), expected, rtol=0,
+                                   atol=1e-12)
+
+
+@pytest.mark.parametrize("form", WINDOWS)
+def test_stops_clear_matches_the_reference(form):
+    window, rng = WINDOWS[form], np.random.default_rng(12)
+    brake = min(window.params.a_a, window.limits.accel_max)
+    checked = blocked = 0
+    for _ in range(100):
+        v, omega, points, margin = scene(rng)
+        r = window.radius + margin
+        dist = np.hypot(points[:, 0], points[:, 1])
+        stop_points = [(x, y, r if d >= r else window.radius) for (x, y), d in zip(points, dist)
+                       if d >= window.radius]
+        steps = _braking_steps(float(np.abs(v).max()), brake, 2 * window.dt)
+        expected = [_stops_clear(a, w, stop_points, window, steps) for a, w in zip(v, omega)]
+        got = window.stops_clear(v, omega, points, margin)
+        assert got.tolist() == expected
+        checked += len(expected)
+        blocked += expected.count(False)
+    assert 0.1 * checked < blocked < 0.9 * checked  # the scenes test both outcomes
