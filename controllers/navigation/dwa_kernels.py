@@ -1,14 +1,15 @@
-"""The dynamic window's two innermost loops, compiled (numba): every candidate against every obstacle point.
+"""The dynamic-window controller's innermost loops, compiled (numba): every candidate against every point.
 
 - :func:`collision_distances`: DC_cd of §3.5, how far the centre travels along each candidate's arc (3.11)
   before the robot's circle touches a point, capped at DC_cdmax;
 - :func:`stops_clear`: ST_v (3.33) by integration, whether the robot, holding a candidate one cycle and then
-  braking along its curvature, keeps its circle clear of every point.
+  braking along its curvature, keeps its circle clear of every point;
+- :func:`thin_to_robot_frame`: the obstacle memory, one point per 2 cm square, in the robot frame.
 
-They are :class:`~teamsim.controllers.navigation.dynamic_window.DynamicWindow`'s methods of the same names, whose
-docstrings give the reasoning; here the same arithmetic runs as plain loops, one candidate and one point at a
-time, and a candidate stops at the first point that settles it. Vectorised numpy spent most of a decision
-creating arrays for a few thousand pairs (docs/decisions.md, "Navigation decisions compiled").
+The first two are :class:`~teamsim.controllers.navigation.dynamic_window.DynamicWindow`'s methods of the same
+names, whose docstrings give the reasoning; here the same arithmetic runs as plain loops, one candidate and one
+point at a time, and a candidate stops at the first point that settles it. Vectorised numpy spent most of a
+decision creating arrays for a few thousand pairs (docs/decisions.md, "Navigation decisions compiled").
 """
 from __future__ import annotations
 
@@ -18,6 +19,7 @@ import numpy as np
 from numba import njit
 
 STILL = 1e-9  # |v| or |omega| at or below this is zero
+BAND_SLACK = 1e-9  # relative: the squared pre-test against an arc's band never drops a point the exact test keeps
 
 
 @njit("b1(f8, f8, f8)", cache=True)
@@ -56,6 +58,10 @@ def collision_distances(v, omega, px, py, radius, margin, offset, dc_max):  # no
             r = enlarged if distance[j] >= enlarged else radius
             if turning:
                 qx, qy = px[j] + offset, py[j] - icr_y
+                # Far outside the band |d - rho| < r, by squares (no square root); the exact test follows.
+                d2 = qx * qx + qy * qy
+                if d2 > (rho + r) ** 2 * (1 + BAND_SLACK) or (rho > r and d2 < (rho - r) ** 2 * (1 - BAND_SLACK)):
+                    continue
                 d = math.hypot(qx, qy)
                 if abs(d - rho) < r:
                     ahead = np.mod(turn * (math.atan2(qy, qx) - centre_angle), 2 * np.pi)
@@ -70,12 +76,25 @@ def collision_distances(v, omega, px, py, radius, margin, offset, dc_max):  # no
     return out
 
 
-@njit("b1[::1](f8[::1], f8[::1], f8[::1], f8[::1], f8[::1], f8, f8, f8, f8)", cache=True)
-def stops_clear(v, omega, px, py, radii, offset, dt, brake, turn):  # noqa: PLR0913
+@njit("b1[::1](f8[::1], f8[::1], f8[::1], f8[::1], f8, f8, f8, f8, f8, f8, f8)", cache=True)
+def stops_clear(v, omega, all_x, all_y, radius, margin, reach, offset, dt, brake, turn):  # noqa: PLR0913
     """ST_v per candidate: the centre's path, one cycle at (v, omega) then braking at ``brake`` two cycles a step
-    (the turn rate following the curvature, changing at most ``turn`` a step), clear of every point (px, py),
-    each by its own radius."""
-    n, m = v.shape[0], px.shape[0]
+    (the turn rate following the curvature, changing at most ``turn`` a step), clear of the points outside the
+    robot's circle and nearer than ``reach``: by the circle enlarged by ``margin``, or by the robot's own circle
+    for a point between the two."""
+    n = v.shape[0]
+    enlarged = radius + margin
+    px, py, radii = np.empty(all_x.shape[0]), np.empty(all_x.shape[0]), np.empty(all_x.shape[0])
+    m = 0
+    for j in range(all_x.shape[0]):
+        distance = math.hypot(all_x[j], all_y[j])
+        if radius <= distance < reach:
+            px[m], py[m] = all_x[j], all_y[j]
+            radii[m] = enlarged if distance >= enlarged else radius
+            m += 1
+    clear = np.ones(n, np.bool_)
+    if m == 0:
+        return clear
     top = 0.0
     for k in range(n):
         top = max(top, abs(v[k]))
@@ -89,7 +108,6 @@ def stops_clear(v, omega, px, py, radii, offset, dt, brake, turn):  # noqa: PLR0
     threshold = np.empty(m)
     for j in range(m):
         threshold[j] = (px[j] ** 2 + py[j] ** 2 - radii[j] ** 2) / 2
-    clear = np.ones(n, np.bool_)
     for k in range(n):
         speed_now, w_now = abs(v[k]), omega[k]
         moving = speed_now > STILL
@@ -119,3 +137,30 @@ def stops_clear(v, omega, px, py, radii, offset, dt, brake, turn):  # noqa: PLR0
                 break
             speed_now, w_now = speed_next, w_next
     return clear
+
+
+@njit("f8[:, ::1](f8[:, ::1], f8, f8, f8, f8, f8, f8)", cache=True)
+def thin_to_robot_frame(world, cell, ox, oy, c, s, offset):  # noqa: PLR0913
+    """The obstacle memory's points (world frame) thinned to one per ``cell``-sized square (the first one
+    remembered in each, in the order of the squares' keys, as ``np.unique(..., return_index=True)`` gives
+    them), then relative to the centre in the robot frame at odometry pose (ox, oy) with cos c and sin s."""
+    m = world.shape[0]
+    ix, iy = np.empty(m, np.int64), np.empty(m, np.int64)
+    for j in range(m):
+        ix[j], iy[j] = np.round(world[j, 0] / cell), np.round(world[j, 1] / cell)
+    if m:
+        ix -= min(ix.min(), 0)
+        iy -= min(iy.min(), 0)
+    width = max(iy.max(), 0) + 1 if m else 1
+    key = ix * width + iy
+    order = np.argsort(key, kind="mergesort")  # stable: the first of equal keys comes first
+    out = np.empty((m, 2))
+    kept = 0
+    for n in range(m):
+        j = order[n]
+        if n and key[j] == key[order[n - 1]]:
+            continue
+        dx, dy = world[j, 0] - ox, world[j, 1] - oy
+        out[kept, 0], out[kept, 1] = c * dx + s * dy - offset, -s * dx + c * dy
+        kept += 1
+    return out[:kept].copy()

@@ -126,6 +126,7 @@ STEER_REQUEST = 0.01  # rad/s: the turn-only command (0, +-this) that turns a st
 STALL_DRIVEN_SPEED = 0.05
 STALL_SPEED_SHARE = 0.25
 NO_CONTACT = np.zeros((0, 2))  # obstacle points of no stall
+MEMORY_CELL = 0.02  # m: the obstacle memory keeps one point per square of this side
 
 
 class Method(enum.Enum):
@@ -369,25 +370,16 @@ class DynamicWindow:
         by ``margin`` stays clear of every obstacle point outside it, and the robot's own circle of every point
         between the two (as in ``collision_distances``)."""
         p, lim = self.params, self.limits
-        r = self.radius + margin
-        distance = np.hypot(points[:, 0], points[:, 1])
-        outside = distance >= self.radius
-        pts, distance = points[outside], distance[outside]
-        if pts.shape[0] == 0 or v.size == 0:
-            return np.ones(v.size, bool)
-        radii = np.where(distance >= r, r, self.radius)
-        speed = np.abs(v)
+        if v.size == 0:
+            return np.ones(0, bool)
         brake = min(p.a_a, lim.accel_max)
         # Only points the enlarged circle can reach: the centre moves at most the reference point's stopping
         # path plus twice the offset (the centre swung round to the reference point's other side).
-        path = speed.max() * self.dt + speed.max() ** 2 / (2 * brake) + 0.1
-        reachable = distance < r + path + 2 * abs(self.offset)
-        pts, radii = pts[reachable], radii[reachable]
-        if pts.shape[0] == 0:
-            return np.ones(v.size, bool)
-        x, y = _columns(pts)
-        return kernels.stops_clear(_floats(v), _floats(omega), x, y, radii, self.offset, self.dt, brake,
-                                   lim.angular_accel_max * 2 * self.dt)
+        fastest = float(np.abs(v).max())
+        reach = self.radius + margin + fastest * self.dt + fastest ** 2 / (2 * brake) + 0.1 + 2 * abs(self.offset)
+        x, y = _columns(points)
+        return kernels.stops_clear(_floats(v), _floats(omega), x, y, self.radius, margin, reach, self.offset, self.dt,
+                                   brake, lim.angular_accel_max * 2 * self.dt)
 
     def towards(self, v: np.ndarray, omega: np.ndarray, points: np.ndarray) -> np.ndarray:
         """For each candidate, whether the centre moves towards any of ``points``: one of them lies ahead along the
@@ -739,15 +731,9 @@ class DynamicWindowController:
                                                        oy + s * body[:, 0] + c * body[:, 1]])))
         while self.memory[0][0] < obs.time - self.memory_seconds:
             self.memory.popleft()
-        world = np.concatenate([pts for _, pts in self.memory])
         # A slow robot sees the same spots again and again: keep one point per 2 cm cell.
-        # (One integer key per cell, ordered as the cells' (x, y) pairs are: np.unique on rows is far slower.)
-        cell = np.round(world / 0.02).astype(np.int64)
-        cell -= cell.min(axis=0, initial=0)
-        _, first = np.unique(cell[:, 0] * (cell[:, 1].max(initial=0) + 1) + cell[:, 1], return_index=True)
-        world = world[first]
-        dx, dy = world[:, 0] - ox, world[:, 1] - oy
-        return np.column_stack([c * dx + s * dy - self.offset, -s * dx + c * dy])
+        world = np.ascontiguousarray(np.concatenate([pts for _, pts in self.memory]), dtype=float)
+        return kernels.thin_to_robot_frame(world, MEMORY_CELL, ox, oy, c, s, self.offset)
 
     def _command(self, v: float, omega: float, behaviour: str) -> Command:
         """Issue (v, omega) and track the drive state it leads to; a tricycle's steering angle follows as the

@@ -33,11 +33,13 @@ unicycle or bicycle kinematics): the smoke test of the controllers and the timin
 """
 from __future__ import annotations
 
+import functools
 import math
 import time as time_module
 from dataclasses import dataclass
 
 import numpy as np
+from numba import njit
 
 from teamsim.controllers.base import Observation
 from teamsim.controllers.navigation.astar import modified_astar
@@ -74,6 +76,13 @@ class NavWorld:
     size: float
     start: tuple[float, float, float]  # x, y, heading (facing the goal)
     goal: tuple[float, float]
+
+    @functools.cached_property
+    def box_corners(self) -> tuple[np.ndarray, np.ndarray]:
+        """The boxes' lower-left and upper-right corners, (boxes, 2) each."""
+        lo = np.array([[b.x - b.half_x, b.y - b.half_y] for b in self.boxes]).reshape(-1, 2)
+        hi = np.array([[b.x + b.half_x, b.y + b.half_y] for b in self.boxes]).reshape(-1, 2)
+        return lo, hi
 
     @property
     def density(self) -> float:
@@ -192,20 +201,53 @@ def has_passage(world: NavWorld, radius: float) -> bool:
 
 def ray_ranges(world: NavWorld, origins: np.ndarray, directions: np.ndarray, max_range: float) -> np.ndarray:
     """Ideal range readings: distance from each origin (n, 2) along its unit direction (n, 2) to the first box
-    face or wall, ``inf`` beyond ``max_range`` (slab intersection, all rays and boxes at once)."""
-    lo = np.array([[b.x - b.half_x, b.y - b.half_y] for b in world.boxes]).reshape(-1, 2)
-    hi = np.array([[b.x + b.half_x, b.y + b.half_y] for b in world.boxes]).reshape(-1, 2)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        inverse = 1.0 / directions  # inf along an axis the ray does not move on: the slab test still holds
-        t1 = (lo[None] - origins[:, None]) * inverse[:, None]
-        t2 = (hi[None] - origins[:, None]) * inverse[:, None]
-        near = np.nanmax(np.minimum(t1, t2), axis=2)
-        far = np.nanmin(np.maximum(t1, t2), axis=2)
-        half = world.size / 2
-        wall = np.nanmin(np.maximum((-half - origins) * inverse, (half - origins) * inverse), axis=1)
-    boxes = np.where((near <= far) & (near >= 0), near, np.inf).min(axis=1, initial=np.inf)
-    distance = np.minimum(boxes, wall)
-    return np.where(distance < max_range, distance, np.inf)
+    face or wall, ``inf`` beyond ``max_range`` (slab intersection, compiled: one ray and one box at a time)."""
+    lo, hi = world.box_corners
+    return _ray_ranges(np.ascontiguousarray(origins, dtype=float), np.ascontiguousarray(directions, dtype=float),
+                       lo, hi, world.size / 2, max_range)
+
+
+@njit("f8(f8, f8)", cache=True)
+def _minimum(a, b):  # np.minimum: a NaN wins
+    return a if a <= b or a != a else b
+
+
+@njit("f8(f8, f8)", cache=True)
+def _maximum(a, b):  # np.maximum
+    return a if a >= b or a != a else b
+
+
+@njit("f8(f8, f8)", cache=True)
+def _fmin(a, b):  # np.fmin (np.nanmin of two): a NaN loses
+    return a if a <= b or b != b else b
+
+
+@njit("f8(f8, f8)", cache=True)
+def _fmax(a, b):  # np.fmax (np.nanmax of two)
+    return a if a >= b or b != b else b
+
+
+@njit("f8[::1](f8[:, ::1], f8[:, ::1], f8[:, ::1], f8[:, ::1], f8, f8)", cache=True, error_model="numpy")
+def _ray_ranges(origins, directions, lo, hi, half, max_range):  # noqa: PLR0913
+    """The slab test as numpy wrote it over all rays and boxes at once (a ray that does not move along an axis has
+    an infinite inverse there, and 0 x inf is NaN: NaN is handled as numpy's minimum, maximum, nanmin and nanmax
+    handle it), so that the readings are the same to the bit."""
+    out = np.empty(origins.shape[0])
+    for i in range(origins.shape[0]):
+        ox, oy = origins[i, 0], origins[i, 1]
+        ix, iy = 1.0 / directions[i, 0], 1.0 / directions[i, 1]
+        boxes = math.inf
+        for b in range(lo.shape[0]):
+            x1, x2 = (lo[b, 0] - ox) * ix, (hi[b, 0] - ox) * ix
+            y1, y2 = (lo[b, 1] - oy) * iy, (hi[b, 1] - oy) * iy
+            near = _fmax(_minimum(x1, x2), _minimum(y1, y2))
+            far = _fmin(_maximum(x1, x2), _maximum(y1, y2))
+            if near <= far and near >= 0:
+                boxes = _minimum(boxes, near)
+        wall = _fmin(_maximum((-half - ox) * ix, (half - ox) * ix), _maximum((-half - oy) * iy, (half - oy) * iy))
+        distance = _minimum(boxes, wall)
+        out[i] = distance if distance < max_range else math.inf
+    return out
 
 
 def clearance(world: NavWorld, x: float, y: float) -> float:

@@ -7,6 +7,7 @@ import math
 import numpy as np
 import pytest
 
+from teamsim.controllers.navigation import dwa_kernels as kernels
 from teamsim.controllers.navigation.dynamic_window import DynamicWindow
 from teamsim.controllers.navigation.reference_dwa import _braking_steps, _collision_distance, _stops_clear
 from teamsim.models.robot import DriveLimits
@@ -57,3 +58,21 @@ def test_stops_clear_matches_the_reference(form):
         checked += len(expected)
         blocked += expected.count(False)
     assert 0.1 * checked < blocked < 0.9 * checked  # the scenes test both outcomes
+
+
+def test_memory_thinning_keeps_the_first_point_of_every_cell_as_np_unique_does():
+    rng, kept, seen = np.random.default_rng(13), 0, 0
+    for _ in range(50):
+        spread, crowd = rng.integers(0, 200, 2)  # the crowd, 10 cm across, has many points in one 2 cm cell
+        world = np.round(np.concatenate([rng.uniform(-3.0, 3.0, (spread, 2)), rng.uniform(-0.05, 0.05, (crowd, 2))]), 2)
+        ox, oy, heading = rng.uniform(-2.0, 2.0, 3)
+        c, s = math.cos(heading), math.sin(heading)
+        cell = np.round(world / 0.02).astype(np.int64)
+        cell -= cell.min(axis=0, initial=0)
+        _, first = np.unique(cell[:, 0] * (cell[:, 1].max(initial=0) + 1) + cell[:, 1], return_index=True)
+        dx, dy = world[first, 0] - ox, world[first, 1] - oy
+        expected = np.column_stack([c * dx + s * dy - 0.25, -s * dx + c * dy]).reshape(-1, 2)
+        got = kernels.thin_to_robot_frame(np.ascontiguousarray(world), 0.02, ox, oy, c, s, 0.25)
+        np.testing.assert_array_equal(got, expected)
+        kept, seen = kept + len(got), seen + len(world)
+    assert kept < 0.9 * seen  # the scenes do have points to thin
