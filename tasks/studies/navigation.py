@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import time
 import zlib
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -27,7 +28,7 @@ from teamsim.config import TrialConfig
 from teamsim.files import write_atomic, write_csv
 from teamsim.plots import grouped_bars
 from teamsim.stats import paired_t_test
-from teamsim.sweep import run_trials
+from teamsim.sweep import default_workers, run_trials
 from teamsim.tasks.missions.navigate import METHODS, TABLE_3_1, NavigateParams, kinematic_trial, time_limit
 
 COLUMNS = ("robot", "density", "controller", "trial", "seed", "world_seed", "success", "nav_time", "path_index",
@@ -154,11 +155,13 @@ def compare(cells: dict, robot: str, density: float, controller: str) -> dict:
 
 def run_study(study: NavigationStudy) -> Path:
     configs = trial_configs(study)
+    began = time.perf_counter()
     summaries = run_trials(configs, workers=study.workers, run=BACKENDS[study.backend])
+    wall_s = time.perf_counter() - began
     rows = [result_row(c, s) for c, s in zip(configs, summaries)]
     study.out.mkdir(parents=True, exist_ok=True)
     write_results(study.out / "results.csv", rows)
-    write_report(study, rows)
+    write_report(study, rows, wall_s)
     return study.out
 
 
@@ -193,21 +196,37 @@ CAUSES = {
             "slow it and the detour lowers PI and AV, so HRDK can fall below FRC in a cell.",
     "rfrc": "RFRC drops alpha_3 (and, for the tricycle, DCF and CL_ob). Near obstacles alpha_3 scales every "
             "candidate of FRC by 0.01, which changes FRC's choices only against candidates that keep DC_cdmin "
-            "clear; where those are rare, FRC creeps and RFRC does not. With 10 trials a cell, one failed trial "
-            "moves a cell's OS ratio by about 0.1, past this check's tolerance, without being significant.",
+            "clear; where those are rare, FRC creeps and RFRC does not. {sample_rfrc}",
     "success": "FRC is purely reactive and sees obstacles in only 10-14 directions. Its failures are "
                "wandering and stalls: looping or rocking to and fro in a pocket of merged boxes, or at a gap "
                "that admits the robot's body but not its circle enlarged by the safety margin (1.2 m across "
                "for A, 1.54 m for C; boxes that do not overlap keep 1.34 m apart), where the direction sensor "
                "keeps choosing the gap. (Touch-locks, halted against a box corner between the beams and asking "
                "for the same motion for good, ended when the controllers began to detect stalls by odometry.) "
-               "With 10 trials a cell, one failure costs 10 points of SR: a robot that arrives in 92 % of all "
-               "worlds shows 8 of 10 or fewer in at least one of four cells 56 % of the time (binomial).",
+               "{sample_success}",
 }
+
+
+def at_most(count: int, trials: int, p: float) -> float:
+    """Binomial: the chance of ``count`` or fewer successes in ``trials`` at success rate ``p``."""
+    return sum(math.comb(trials, k) * p ** k * (1 - p) ** (trials - k) for k in range(count + 1))
+
+
+def sample_notes(trials: int) -> dict[str, str]:
+    """What one trial weighs at this sample size, for the causes above."""
+    worst = math.floor(0.88 * trials)  # the most successes that still miss "> 88 %"
+    miss = 1 - (1 - at_most(worst, trials, 0.92)) ** 4
+    return {"sample_rfrc": f"With {trials} trials a cell, one failed trial moves a cell's OS ratio by about "
+                           f"{1 / trials:.2g} (this check allows 0.1).",
+            "sample_success": f"With {trials} trials a cell, one failure costs {100 / trials:.2g} "
+                              f"point{'' if trials == 100 else 's'} of SR: a robot that arrives in 92 % of all "
+                              f"worlds shows {worst} of {trials} or fewer in at least one of four cells "
+                              f"{100 * miss:.0f} % of the time (binomial)."}
 
 
 def orderings(study: NavigationStudy, cells: dict) -> list[Ordering]:
     """The chapter 3 orderings the issue asks for, with teamsim's figures."""
+    causes = {name: cause.format(**sample_notes(study.trials)) for name, cause in CAUSES.items()}
     def ratios(controller: str, densities=study.densities) -> list[float]:
         values = [compare(cells, r, d, controller)["os_ratio"] for r in study.robots for d in densities
                   if (r, d, controller) in cells and (r, d, "FRC") in cells]
@@ -221,34 +240,34 @@ def orderings(study: NavigationStudy, cells: dict) -> list[Ordering]:
         lower = [1 - v for v in ratios("ODW")]
         claims.append(Ordering("FRC >> ODW on overall score", "ODW's OS 37-74 % lower",
                                f"ODW's OS {span(lower, 100, 0)} % lower" if lower else "n/a",
-                               float(np.median(lower)) >= 0.2 if lower else None, CAUSES["odw"]))
+                               float(np.median(lower)) >= 0.2 if lower else None, causes["odw"]))
         for robot in [r for r in ("A", "C") if r in study.robots]:
             sr = [cells[(robot, d, "ODW")].sr for d in study.densities]
             claims.append(Ordering(f"ODW success rate of robot {robot}", "< 5 %", f"{100 * max(sr):.0f} % at most",
-                                   max(sr) < 0.05, CAUSES["odw"]))
+                                   max(sr) < 0.05, causes["odw"]))
     if "ODWDS" in study.controllers:
         values = ratios("ODWDS")
         claims.append(Ordering("FRC > ODWDS on overall score", "FRC better by up to 27.5 % (all p < 0.01)",
                                f"ODWDS/FRC OS ratio {span(values)}" if values else "n/a",
-                               float(np.median(values)) < 1.0 if values else None, CAUSES["odwds"]))
+                               float(np.median(values)) < 1.0 if values else None, causes["odwds"]))
     if "HRDK" in study.controllers:
         values = ratios("HRDK")
         claims.append(Ordering("HRDK >= FRC in known worlds", "OS ratio > 1 in all 12 cells, best +8 %",
                                f"HRDK/FRC OS ratio {span(values)}" if values else "n/a",
-                               float(np.median(values)) >= 0.98 if values else None, CAUSES["hrdk"]))
+                               float(np.median(values)) >= 0.98 if values else None, causes["hrdk"]))
     if "RFRC" in study.controllers:
         values = ratios("RFRC", [d for d in study.densities if d <= 0.10 + 1e-9])
         claims.append(Ordering("RFRC ~ FRC except at high density",
                                "no significant OS difference for B; worse for A, C at 15-20 %",
                                f"RFRC/FRC OS ratio at 5-10 %: {span(values)}" if values else "n/a (no 5-10 % cells)",
-                               all(abs(v - 1) <= 0.1 for v in values) if values else None, CAUSES["rfrc"]))
+                               all(abs(v - 1) <= 0.1 for v in values) if values else None, causes["rfrc"]))
     for robot in [r for r in ("A", "B") if r in study.robots]:
         sr = [cells[(robot, d, "FRC")].sr for d in study.densities if (robot, d, "FRC") in cells]
         if sr:
             per_density = "/".join(f"{100 * v:.0f}" for v in sr)
             claims.append(Ordering(f"FRC success rate of robot {robot}", "> 88 %",
                                    f"{100 * min(sr):.0f} % at least ({per_density} %)", min(sr) > 0.88,
-                                   CAUSES["success"]))
+                                   causes["success"]))
     return claims
 
 
@@ -264,11 +283,15 @@ def failure_kinds(cell: Cell) -> str:
     return f"{stalled} stalled, {len(failed) - stalled} wandered"
 
 
-def write_report(study: NavigationStudy, rows: list[dict]) -> None:
+def write_report(study: NavigationStudy, rows: list[dict], wall_s: float | None = None) -> None:
+    """report.md and os.png from the study's rows; ``wall_s``, the sweep's wall time, is quoted when given."""
     cells = cells_of(rows)
     found = orderings(study, cells)
+    ran = f" {len(rows)} trials in {wall_s / 60:.0f} min on {study.workers or default_workers()} workers." \
+        if wall_s is not None else ""
     lines = ["# Navigation study (Chand ch.3) re-run in teamsim", "",
-             f"{study.trials} trials per cell (the thesis: 100), {study.backend} backend; robots {', '.join(study.robots)}; densities "
+             f"{study.trials} trials per cell (the thesis: 100), {study.backend} backend;{ran} robots "
+             f"{', '.join(study.robots)}; densities "
              f"{', '.join(f'{d:.0%}' for d in study.densities)}; controllers {', '.join(study.controllers)}. "
              "Trial k at a density uses the same world for every robot and controller. "
              "Per-trial rows: `results.csv`.", "", "## Orderings against the thesis", "",

@@ -4,8 +4,10 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from teamsim.tasks.studies.navigation import (CAUSES, STALLED, NavigationStudy, cells_of, failure_kinds, orderings,
-                                              write_report)
+import pytest
+
+from teamsim.tasks.studies.navigation import (CAUSES, STALLED, NavigationStudy, at_most, cells_of, failure_kinds,
+                                              orderings, sample_notes, write_report)
 
 
 def row(robot, density, controller, trial, success, avg_velocity=0.4, path_index=0.9):
@@ -33,7 +35,7 @@ def rows():
 def test_orderings_name_a_cause_for_each_one_not_reproduced():
     found = {o.claim: o for o in orderings(study(), cells_of(rows()))}
     assert found["FRC success rate of robot A"].verdict == "**no**"
-    assert found["FRC success rate of robot A"].cause == CAUSES["success"]
+    assert found["FRC success rate of robot A"].cause == CAUSES["success"].format(**sample_notes(4))
     assert found["FRC success rate of robot B"].verdict == "yes"
     # RFRC ~ FRC is claimed at 5-10 % only: a 20 % study does not measure it.
     assert found["RFRC ~ FRC except at high density"].verdict == "not measured"
@@ -50,6 +52,15 @@ def test_report_lists_the_causes(tmp_path):
     write_report(study(tmp_path), rows())
     report = (tmp_path / "report.md").read_text()
     assert "Not reproduced, and why:" in report
-    assert "**FRC success rate of robot A**" in report and CAUSES["success"] in report
+    assert "**FRC success rate of robot A**" in report
+    assert CAUSES["success"].format(**sample_notes(4)) in report and "With 4 trials a cell" in report
     assert "| A | 20% | FRC |" in report and "0 stalled" not in report
     assert (tmp_path / "os.png").stat().st_size > 0
+
+
+def test_what_one_trial_weighs_follows_the_sample_size():
+    assert at_most(8, 10, 0.92) == pytest.approx(1 - 10 * 0.92 ** 9 * 0.08 - 0.92 ** 10)
+    assert at_most(10, 10, 0.5) == pytest.approx(1.0)
+    assert "8 of 10 or fewer in at least one of four cells 57 %" in sample_notes(10)["sample_success"]
+    assert "88 of 100 or fewer" in sample_notes(100)["sample_success"]
+    assert "about 0.01" in sample_notes(100)["sample_rfrc"]
