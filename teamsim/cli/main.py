@@ -301,29 +301,20 @@ def cmd_allocate(args) -> int:
     return allocate(args)
 
 
+# teamsim bench WHAT: the module that measures it and its function (imported only when asked for)
+BENCHES = {"allocate": ("allocate", "bench_allocate"), "nav": ("nav", "bench_nav"), "sweep": ("sweep", "bench_sweep"),
+           "alliance": ("alliance", "bench_alliance")}
+
+
 def cmd_bench(args) -> int:
+    import importlib
+
+    if args.what in BENCHES:
+        module, function = BENCHES[args.what]
+        getattr(importlib.import_module(f"teamsim.bench.{module}"), function)()
+        return 0
     from teamsim.bench import physics as bench
 
-    if args.what == "allocate":
-        from teamsim.bench.allocate import bench_allocate
-
-        bench_allocate()
-        return 0
-    if args.what == "nav":
-        from teamsim.bench.nav import bench_nav
-
-        bench_nav()
-        return 0
-    if args.what == "sweep":
-        from teamsim.bench.sweep import bench_sweep
-
-        bench_sweep()
-        return 0
-    if args.what == "alliance":
-        from teamsim.bench.alliance import bench_alliance
-
-        bench_alliance()
-        return 0
     if args.what == "physics":
         bench.physics(seconds=args.seconds or 10.0)
         print()
