@@ -5,7 +5,9 @@ real-time factor of
   (a) bare ``mujoco.mj_step`` on the same compiled model, sensors off, one C call for all steps;
   (b) the full stack: faults, IR sensing through the IR model, positioning, radio, controllers, locomotion,
       energy sampling and trajectory recording;
-and the ratio b/a (the share of the physics rate that survives the Python layer).
+and the ratio b/a (the share of the physics rate that survives the Python layer). Then where (a)'s time goes,
+from MuJoCo's own timers: collision detection, building the constraint rows, the constraint solver and the
+rest (kinematics, inertia, integration), per step and per robot, with the contacts and rows per robot.
 
 cleanup: the 3-robot hazardous-waste mission's real-time factor (the issue's target: >= 20x on one core, no video),
 with resting objects asleep (as shipped, see :func:`teamsim.models.arenas.walled_room`) and with sleeping
@@ -48,6 +50,30 @@ def bare_steps_per_second(world: World, steps: int) -> float:
     return steps / (time.perf_counter() - start)
 
 
+# MuJoCo's timers, grouped into the parts a model change could cut
+PHASES = {"collision": ("mjTIMER_POS_COLLISION",), "rows": ("mjTIMER_POS_MAKE", "mjTIMER_POS_PROJECT"),
+          "solver": ("mjTIMER_CONSTRAINT",)}
+
+
+def physics_time_split(world: World, steps: int) -> dict:
+    """Microseconds per bare step in each of PHASES and the rest, and contacts and rows per robot."""
+    model = mujoco.MjModel.from_xml_string(world.xml)
+    model.opt.disableflags |= int(mujoco.mjtDisableBit.mjDSBL_SENSOR)
+    data = mujoco.MjData(model)
+    data.ctrl[:] = np.clip(3.0, model.actuator_ctrlrange[:, 0], model.actuator_ctrlrange[:, 1])
+    mujoco.mj_step(model, data, nstep=steps)
+
+    def microseconds(timer: str) -> float:
+        record = data.timer[int(mujoco.mjtTimer.__members__[timer])]
+        return record.duration / max(record.number, 1) * 1e6
+
+    split = {phase: sum(map(microseconds, timers)) for phase, timers in PHASES.items()}
+    split["other"] = microseconds("mjTIMER_STEP") - sum(split.values())
+    robots = len(world.robots)
+    split |= {"contacts_per_robot": data.ncon / robots, "rows_per_robot": data.nefc / robots}
+    return split
+
+
 def stack_steps_per_second(world: World, seconds: float) -> float:
     """(b): the full control loop, as ``run_trial`` runs it without outputs."""
     recorder = TrajectoryRecorder(world.xml, list(world.robots), 30, world.physics_dt)
@@ -77,6 +103,14 @@ def physics(seconds: float = 10.0, sizes: tuple[int, ...] = TEAM_SIZES, repeats:
         rows.append(row)
         print(f"{n:>6} {bare:>17.0f} {row['bare_rtf']:>6.1f}x {stack:>18.0f} {row['stack_rtf']:>6.1f}x "
               f"{row['ratio']:>6.2f}", flush=True)
+    print("where (a)'s time goes, microseconds per step (per robot in brackets), from MuJoCo's timers")
+    print(f"{'robots':>6} " + " ".join(f"{phase:>14}" for phase in (*PHASES, "other"))
+          + f" {'contacts/robot':>15} {'rows/robot':>11}")
+    for row in rows:
+        n = row["robots"]
+        row["split"] = split = physics_time_split(_wander_world(n), round(seconds / 2 / _wander_world(1).physics_dt))
+        print(f"{n:>6} " + " ".join(f"{split[p]:>7.0f} ({split[p] / n:>4.1f})" for p in (*PHASES, "other"))
+              + f" {split['contacts_per_robot']:>15.1f} {split['rows_per_robot']:>11.1f}", flush=True)
     return rows
 
 
