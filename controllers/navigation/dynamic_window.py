@@ -112,6 +112,8 @@ from teamsim.controllers.base import Command, Observation
 from teamsim.controllers.navigation import dwa_kernels as kernels
 from teamsim.controllers.navigation.astar import PlannerParams, WeightAdaptation, adapt_weights, plan_on_grid
 from teamsim.controllers.navigation.occupancy_grid import OccupancyGrid
+from teamsim.controllers.navigation.path_following import PathFollower, PathFollowing
+from teamsim.controllers.navigation.trap_escape import TrapEscape
 from teamsim.controllers.navigation.polar_histogram import (DirectionSensorParams, modified_target_heading,
                                                             target_heading, wrap)
 from teamsim.controllers.skills.locomotion import next_steer
@@ -395,9 +397,10 @@ class DynamicWindow:
     # ------------------------------------------------------------------ the decision
 
     def decide(self, state: DriveState, points: np.ndarray, heading: float, d_tgt: float,
-               v_min_previous: float = 0.0) -> Decision:
+               v_min_previous: float = 0.0, v_cap: float = math.inf) -> Decision:
         """(v, omega) for the next cycle. ``points``: obstacle points (m, 2) relative to the robot's centre in the
-        robot frame; ``heading``: theta_tmod relative to the robot; ``d_tgt``: distance to the final goal."""
+        robot frame; ``heading``: theta_tmod relative to the robot; ``d_tgt``: distance to the final goal;
+        ``v_cap``: a further limit on forward speed (0: stop and turn, as a trapped FRC does, ``trap_escape``)."""
         p, lim = self.params, self.limits
         points = np.asarray(points, float).reshape(-1, 2)
         distance = np.hypot(points[:, 0], points[:, 1])
@@ -410,7 +413,7 @@ class DynamicWindow:
         d_obrr = nearest(bearing >= math.pi - p.rear_half_angle)  # (3.19)-(3.20)
         d_obirr = nearest(bearing >= math.pi - p.immediate_rear_half_angle)  # (3.21)-(3.22)
 
-        v_glmax = self.goal_speed_limit(d_tgt)
+        v_glmax = min(self.goal_speed_limit(d_tgt), v_cap)
         if self.method.modified:
             v_max = min(v_glmax, self.obstacle_speed_limit(d_obfr))  # (3.18)
             v_min = self.reverse_limit(d_obfr, d_obrr, d_obirr, v_min_previous)
@@ -639,6 +642,13 @@ class _PoseTracker:
         return None if self.correction is None else _compose(self.correction, self.odometry)
 
 
+def _to_frame(pose: tuple[float, float, float], points: np.ndarray) -> np.ndarray:
+    """Points (m, 2) given in the frame of ``pose`` (x, y, heading), in the pose's parent frame."""
+    c, s = math.cos(pose[2]), math.sin(pose[2])
+    x, y = points[:, 0], points[:, 1]
+    return np.column_stack([pose[0] + c * x - s * y, pose[1] + s * x + c * y])
+
+
 class DynamicWindowController:
     """A reactive navigator (FRC, RFRC, ODW or ODWDS) for one robot, driving to ``goal`` (x, y).
 
@@ -648,6 +658,7 @@ class DynamicWindowController:
     centre than its enclosing circle; default: the footprint radius). ``steering``: a tricycle's steering geometry
     (its TricycleSpec will do)."""
     method = Method.FRC
+    escapes_traps = False  # FRC's departure from the thesis (trap_escape); the printed methods have none
 
     def __init__(self, limits: DriveLimits, kind: str, footprint_radius: float, goal: tuple[float, float], *,
                  params: DynamicWindowParams = DynamicWindowParams(),
@@ -670,6 +681,8 @@ class DynamicWindowController:
         self.last_decision: Decision | None = None
         self.previous_direction: float | None = None  # last theta_tmod, world frame
         self.arrived = False
+        self.trail: list[tuple[float, float, float]] = []  # (time, x, y) of every pose estimate, for the outcome
+        self.escape = TrapEscape(self.goal, footprint_radius) if self.escapes_traps else None
 
     @property
     def name(self) -> str:
@@ -681,28 +694,35 @@ class DynamicWindowController:
             self.state = DriveState(obs.velocity[0], obs.velocity[1], self.state.steer)
         v, omega = (self.state.v, self.state.omega) if obs.velocity is None else obs.velocity
         pose = self.tracker.update(obs.time, obs.pose, v, omega)
-        points = self._remember(obs, contact)
+        seen = self._seen(obs, contact)
+        points = self._remember(obs.time, seen)
         if pose is None:
             return self._command(0.0, 0.0, "no fix")
+        self.trail.append((obs.time, pose[0], pose[1]))
+        if self.escape is not None:
+            self.escape.hits.add(_to_frame(pose, seen))
         centre = (pose[0] + self.offset * math.cos(pose[2]), pose[1] + self.offset * math.sin(pose[2]))
         d_tgt = math.dist(centre, self.goal)
         self.arrived = self.arrived or (d_tgt <= self.window.params.d_stop and abs(self.state.v) < 1e-9)
         if self.arrived:
             return self._command(0.0, 0.0, "arrived")
         target = self.waypoint(pose, centre, obs)
-        heading = float(wrap(target_heading(*centre, *target) - pose[2]))
+        heading = raw_heading = float(wrap(target_heading(*centre, *target) - pose[2]))
         if self.method.uses_direction_sensor:
             previous = None if self.previous_direction is None else float(wrap(self.previous_direction - pose[2]))
             heading = modified_target_heading(points, heading, self.radius, self.direction, previous)
             self.previous_direction = heading + pose[2]
-        decision = self.window.decide(self.state, points, heading, d_tgt, self.v_min)
+        turn_first = self.escape is not None and not self.window.tricycle and self.escape.turn_first(raw_heading)
+        decision = self.window.decide(self.state, points, heading, d_tgt, self.v_min, 0.0 if turn_first else math.inf)
         self.last_decision = decision
         self.v_min = decision.v_min
-        return self._command(decision.v, decision.omega, self.name)
+        escaping = self.escape is not None and self.escape.escaping
+        return self._command(decision.v, decision.omega, f"{self.name} escape" if escaping else self.name)
 
     def waypoint(self, pose: tuple[float, float, float], centre: tuple[float, float], obs: Observation):
-        """The point the direction sensor aims at: the goal itself for the reactive controllers."""
-        return self.goal
+        """The point the direction sensor aims at: the goal itself for the reactive controllers, or a trapped
+        FRC's way out (``trap_escape``)."""
+        return self.goal if self.escape is None else self.escape.waypoint(obs.time, centre)
 
     def _contact(self, commanded: DriveState, velocity) -> np.ndarray:
         """Where a stall says the body touches, relative to the pose's reference point in the robot frame: the
@@ -715,22 +735,24 @@ class DynamicWindowController:
         bearing = math.atan2(commanded.omega * self.offset, commanded.v)
         return np.array([[self.offset + self.radius * math.cos(bearing), self.radius * math.sin(bearing)]])
 
-    def _remember(self, obs: Observation, contact: np.ndarray = NO_CONTACT) -> np.ndarray:
-        """This reading's obstacle points, and any stall ``contact``, added to the memory; all remembered points
-        relative to the centre, in the robot frame."""
+    def _seen(self, obs: Observation, contact: np.ndarray) -> np.ndarray:
+        """This reading's obstacle points, and any stall ``contact``, relative to the pose's reference point in
+        the robot frame."""
         ranges = np.asarray(obs.ir_range, float)
         bearings = np.asarray(obs.ir_bearings, float)
         seen = np.isfinite(ranges)
         reach = np.broadcast_to(self.sensor_radius, ranges.shape)[seen] + ranges[seen]
         body = np.column_stack([self.offset + reach * np.cos(bearings[seen]), reach * np.sin(bearings[seen])])
-        if len(contact):
-            body = np.concatenate([body, contact])
+        return np.concatenate([body, contact]) if len(contact) else body
+
+    def _remember(self, time: float, body: np.ndarray) -> np.ndarray:
+        """Points ``body`` (robot frame) added to the memory; all remembered points relative to the centre, in
+        the robot frame."""
         ox, oy, oth = self.tracker.odometry
-        c, s = math.cos(oth), math.sin(oth)
-        self.memory.append((obs.time, np.column_stack([ox + c * body[:, 0] - s * body[:, 1],
-                                                       oy + s * body[:, 0] + c * body[:, 1]])))
-        while self.memory[0][0] < obs.time - self.memory_seconds:
+        self.memory.append((time, _to_frame((ox, oy, oth), body)))
+        while self.memory[0][0] < time - self.memory_seconds:
             self.memory.popleft()
+        c, s = math.cos(oth), math.sin(oth)
         # A slow robot sees the same spots again and again: keep one point per 2 cm cell.
         world = np.ascontiguousarray(np.concatenate([pts for _, pts in self.memory]), dtype=float)
         return kernels.thin_to_robot_frame(world, MEMORY_CELL, ox, oy, c, s, self.offset)
@@ -748,8 +770,19 @@ class DynamicWindowController:
 
 
 class FRC(DynamicWindowController):
-    """Final reactive controller: direction sensor + the full modified dynamic window (§3.6.2)."""
+    """Final reactive controller: direction sensor + the full modified dynamic window (§3.6.2), and a way out of
+    the pockets the printed method circles in for good (``trap_escape``; issue 22)."""
     method = Method.FRC
+    escapes_traps = True
+
+
+class PrintedFRC(DynamicWindowController):
+    """FRC exactly as §3.6.2 prints it, without the trap escape: the thesis's own behaviour, for comparison."""
+    method = Method.FRC
+
+    @property
+    def name(self) -> str:
+        return "frc-printed"
 
 
 class RFRC(DynamicWindowController):
@@ -767,20 +800,12 @@ class ODWDS(DynamicWindowController):
     method = Method.ODWDS
 
 
-@dataclass(frozen=True)
-class PathFollowing:
-    # Not given by the thesis (spec §8); chosen.
-    lookahead: float = 1.0  # m of path: N_t = lookahead / grid resolution nodes (§3.4)
-    search_ahead: int = 4  # the closest node is looked for within this many look-aheads of the previous one
-    clearance: float = 0.2  # m added to the footprint radius when inflating obstacles for planning, so that a
-    # planned passage leaves room for the dynamic window's safety margin
-
-
 class HRDK(FRC):
     """Hybrid reactive-deliberative navigation in a known environment (§3.6.2): plan once with the modified A*
     (known map, so w_p1 = w_p2 = 0) on ``known_map``, impassable cells inflated by the footprint radius plus a
     clearance, then follow the path with FRC, aiming N_t nodes ahead of the path node closest to the robot. Past
     the end of a partial path the robot heads for the goal reactively (§3.2.2)."""
+    escapes_traps = False  # its plan already leads round the pockets
 
     def __init__(self, limits: DriveLimits, kind: str, footprint_radius: float, goal: tuple[float, float], *,
                  known_map: OccupancyGrid, planner: PlannerParams = PlannerParams(),
@@ -789,31 +814,20 @@ class HRDK(FRC):
         self.grid = known_map
         self.planner = planner
         self.following = following
-        self.lookahead_nodes = max(1, round(following.lookahead / known_map.resolution))
-        self.path: np.ndarray | None = None
-        self.path_reaches_goal = False
-        self.node = 0
+        self.follower: PathFollower | None = None
 
     @property
     def name(self) -> str:
         return "hrdk"
 
     def plan(self, centre: tuple[float, float]) -> None:
-        self.path, result = plan_on_grid(self.grid, centre, self.goal, self.planner,
-                                         self.radius + self.following.clearance)
-        self.path_reaches_goal = result.reached
-        self.node = 0
+        path, result = plan_on_grid(self.grid, centre, self.goal, self.planner, self.radius + self.following.clearance)
+        self.follower = PathFollower(path, result.reached, self.grid.resolution, self.following)
 
     def waypoint(self, pose, centre, obs):
-        if self.path is None:
+        if self.follower is None:
             self.plan(centre)
-        window = self.path[self.node:self.node + self.following.search_ahead * self.lookahead_nodes + 1]
-        self.node += int(np.argmin(np.hypot(window[:, 0] - centre[0], window[:, 1] - centre[1])))
-        last = len(self.path) - 1
-        if self.node == last and not self.path_reaches_goal:
-            return self.goal
-        x, y = self.path[min(self.node + self.lookahead_nodes, last)]
-        return float(x), float(y)
+        return self.follower.waypoint(centre, self.goal)
 
 
 @dataclass(frozen=True)
@@ -849,7 +863,7 @@ class HRDU(HRDK):
         self.grid.update(pose, obs.ir_range, obs.ir_bearings, sensor_radius=self.sensor_radius,
                          centre_offset=self.offset, footprint_radius=self.radius)
         distance = math.dist(centre, self.goal)
-        if self.path is None:
+        if self.follower is None:
             self.plan(centre)
             self.last_plan_time = obs.time
             self.progress_check = (obs.time, distance)
@@ -868,7 +882,7 @@ class HRDU(HRDK):
 
     def path_blocked(self) -> bool:
         """Whether a cell now mapped impassable lies within the planning inflation of the path just ahead."""
-        ahead = self.path[self.node:self.node + self.replanning.blocked_lookahead]
+        ahead = self.follower.path[self.follower.node:self.follower.node + self.replanning.blocked_lookahead]
         reach = self.radius + self.following.clearance
         rows, cols = self.grid.world_to_cell(ahead[:, 0], ahead[:, 1])
         margin = int(math.ceil(reach / self.grid.resolution))

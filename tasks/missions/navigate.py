@@ -27,6 +27,8 @@ from teamsim.scene import Scene
 from teamsim.tasks.base import ScenarioMission
 from teamsim.tasks.worlds.navigation import (KinematicRobot, NavWorld, NavWorldParams, cell_centres, covered_cells,
                                              kinematic_run, random_world)
+from teamsim.tasks.missions.looping import failure_kind
+from teamsim.tasks.worlds.uniform_boxes import uniform_world
 
 # Table 3.1's simulated robots: kind and the dimensions that differ from the kind's defaults.
 TABLE_3_1 = {
@@ -34,7 +36,9 @@ TABLE_3_1 = {
     "B": ("diffdrive", {"radius": 0.35}),  # circle, 0.35 m, 0.5 m/s
     "C": ("tracked", {"radius": 0.67, "v_max": 0.3}),  # rectangle, 0.67 m, 0.3 m/s
 }
-METHODS = {"FRC": dw.FRC, "RFRC": dw.RFRC, "ODW": dw.ODW, "ODWDS": dw.ODWDS, "HRDK": dw.HRDK, "HRDU": dw.HRDU}
+METHODS = {"FRC": dw.FRC, "RFRC": dw.RFRC, "ODW": dw.ODW, "ODWDS": dw.ODWDS, "HRDK": dw.HRDK, "HRDU": dw.HRDU,
+           "FRC-printed": dw.PrintedFRC}
+THESIS_METHODS = ("FRC", "RFRC", "ODW", "ODWDS", "HRDK", "HRDU")  # §3.6.2's six, the study's default
 NAV_KINDS = ("tricycle", "diffdrive", "tracked")
 
 
@@ -48,12 +52,17 @@ def time_limit(density: float) -> float:
     return 300.0 if density <= 0.10 + 1e-9 else 450.0
 
 
+WORLD_FAMILIES = ("strata", "uniform")  # random_world, uniform_world
+
+
 @dataclass
 class NavigateParams:
     robot: str = setting("B", choices=(*TABLE_3_1, *NAV_KINDS), meaning="Table 3.1 robot A, B, C, or a kind")
     controller: str = setting("FRC", choices=tuple(METHODS), meaning="navigation method (§3.6.2)")
     density: float = setting(0.10, lo=0.0, hi=0.30, meaning="obstacle density of the 15 m world (§3.6.2)")
     world_seed: int = setting(-1, lo=-1, hi=2**31 - 1, meaning="world layout seed (-1: the trial seed)")
+    worlds: str = setting("strata", choices=WORLD_FAMILIES,
+                          meaning="world family: strata (even, gaps >= Robot C's diameter) or uniform (anywhere)")
 
     def check(self) -> None:
         if self.robot in ROBOT_KINDS and self.robot not in NAV_KINDS:
@@ -76,6 +85,13 @@ class NavigationSettings:
     method: str = setting("FRC", choices=tuple(METHODS), meaning="navigation method (§3.6.2)")
 
 
+def draw_world(params: NavigateParams, rng: np.random.Generator) -> NavWorld:
+    """The trial's world from its family: ``random_world`` (strata) or ``uniform_world``."""
+    if params.worlds == "uniform":
+        return uniform_world(params.density, rng)
+    return random_world(params.density, rng, NavWorldParams())
+
+
 class NavigateMission(ScenarioMission):
     name = "navigate"
     summary = "one robot crosses a random obstacle world corner to corner (Chand §3.6)"
@@ -87,7 +103,7 @@ class NavigateMission(ScenarioMission):
     def scenario(self, params: NavigateParams, rng: np.random.Generator, newcomers) -> Scenario:
         if params.world_seed >= 0:
             rng = np.random.default_rng(params.world_seed)
-        world = random_world(params.density, rng, NavWorldParams())
+        world = draw_world(params, rng)
         kind, options = robot_of(params.robot)
         boxes = [BoxObstacle(**dataclasses.asdict(box)) for box in world.boxes]
         return Scenario(mission=self.name, arena=Arena(size=(world.size, world.size), boxes=boxes),
@@ -136,7 +152,7 @@ class NavigateMission(ScenarioMission):
         name = world.scene.info["robot"]
         robot = world.robots[name]
         metrics = nav_metrics(world.scene.info["nav_world"], robot.model, self._arrived(world), world.pose(robot),
-                              float(world.odometry()[name]), world.time)
+                              float(world.odometry()[name]), world.time, world.scene.info["controller"].trail)
         return metrics["success"], metrics
 
 
@@ -164,13 +180,17 @@ def navigation_controller(method: str, robot: RobotModel, world: NavWorld):
 
 
 def nav_metrics(nav_world: NavWorld, robot: RobotModel, arrived: bool, pose, travelled: float,
-                nav_time: float) -> dict:
+                nav_time: float, trail: list) -> dict:
     """§3.6.2's measures of one trial: success (stopped at the goal), NT, PI (planned over travelled length, on
-    success) and AV (mean speed over v_gmax)."""
+    success) and AV (mean speed over v_gmax); for a failure, how it failed (``looping.failure_kind``) from the
+    controller's ``trail`` of (time, x, y)."""
     x, y = pose[0], pose[1]
     reached = arrived and math.dist((x, y), nav_world.goal) <= 0.5 + robot.footprint_radius
     planned = optimal_path_length(nav_world, robot.footprint_radius)
-    return {
+    trail = np.asarray(trail, float).reshape(-1, 3)
+    failure = {"failure": "", "loop_period": None, "loop_diameter": None} if reached else \
+        failure_kind(trail[:, 0], trail[:, 1:], robot.limits.v_max)
+    return failure | {
         "success": bool(reached),
         "nav_time": round(nav_time, 3),
         "path_length": round(travelled, 3),
@@ -232,12 +252,12 @@ def kinematic_trial(config) -> dict:
     params: NavigateParams = config.params
     params.check()
     rng = np.random.default_rng(params.world_seed if params.world_seed >= 0 else config.seed)
-    world = random_world(params.density, rng, NavWorldParams())
+    world = draw_world(params, rng)
     kind, options = robot_of(params.robot)
     model = build_robot(kind, "red", **options)
     controller = navigation_controller(params.controller, model, world)
     run = kinematic_run(world, controller, kinematic_robot(model), time_limit(params.density), on_contact="stop")
-    metrics = nav_metrics(world, model, run.reached, run.pose, run.travelled, run.time)
+    metrics = nav_metrics(world, model, run.reached, run.pose, run.travelled, run.time, controller.trail)
     metrics["touches"] = run.touches
     return {"mission": "navigate", "seed": config.seed, "run_id": config.run_id,
             "status": "completed" if metrics["success"] else "failed", "completed": metrics["success"],

@@ -29,10 +29,12 @@ from teamsim.files import write_atomic, write_csv
 from teamsim.plots import grouped_bars
 from teamsim.stats import paired_t_test
 from teamsim.sweep import default_workers, run_trials
-from teamsim.tasks.missions.navigate import METHODS, TABLE_3_1, NavigateParams, kinematic_trial, time_limit
+from teamsim.tasks.missions.navigate import (TABLE_3_1, THESIS_METHODS, WORLD_FAMILIES, NavigateParams,
+                                            kinematic_trial, time_limit)
 
 COLUMNS = ("robot", "density", "controller", "trial", "seed", "world_seed", "success", "nav_time", "path_index",
-           "avg_velocity", "path_length", "planned_length", "touches", "status")
+           "avg_velocity", "path_length", "planned_length", "touches", "failure", "loop_period", "loop_diameter",
+           "status")
 BACKENDS = {"kinematic": kinematic_trial, "physics": None}  # None: run_trial, the MuJoCo mission
 
 # What Figs 3.10-3.15 report for each method and robot (spec §2, table of reported numbers), for the report's
@@ -58,16 +60,19 @@ THESIS_FIGURES = {
 class NavigationStudy:
     robots: tuple[str, ...] = tuple(TABLE_3_1)
     densities: tuple[float, ...] = (0.05, 0.10, 0.15, 0.20)
-    controllers: tuple[str, ...] = tuple(METHODS)
+    controllers: tuple[str, ...] = THESIS_METHODS
     trials: int = 10  # the thesis ran 10 worlds x 10 repeats = 100 per cell; 10 is the reduced default
     workers: int | None = None
     out: Path = Path("renders/study-navigation")
     seed: int = 0
     backend: str = "kinematic"  # or "physics" (see the module's docstring)
+    worlds: str = "strata"  # the world family, NavigateParams.worlds
 
     def __post_init__(self) -> None:
         if self.backend not in BACKENDS:
             raise ValueError(f"backend={self.backend!r}: allowed: {', '.join(BACKENDS)}")
+        if self.worlds not in WORLD_FAMILIES:
+            raise ValueError(f"worlds={self.worlds!r}: allowed: {', '.join(WORLD_FAMILIES)}")
 
 
 def world_seed(study: NavigationStudy, density: float, trial: int) -> int:
@@ -85,7 +90,7 @@ def trial_configs(study: NavigationStudy) -> list[TrialConfig]:
             for controller in study.controllers:
                 for trial in range(study.trials):
                     params = NavigateParams(robot=robot, controller=controller, density=density,
-                                            world_seed=world_seed(study, density, trial))
+                                            world_seed=world_seed(study, density, trial), worlds=study.worlds)
                     config = TrialConfig(mission="navigate", params=params, duration=time_limit(density),
                                          seed=trial_seed(robot, density, controller, trial, study.seed),
                                          out=str(study.out / "trials"),
@@ -104,7 +109,8 @@ def result_row(config: TrialConfig, summary: dict) -> dict:
             "path_index": metrics.get("path_index", math.nan), "avg_velocity": metrics.get("avg_velocity", math.nan),
             "path_length": metrics.get("path_length", math.nan),
             "planned_length": metrics.get("planned_length", math.nan), "touches": metrics.get("touches", ""),
-            "status": summary.get("status")}
+            "failure": metrics.get("failure", ""), "loop_period": metrics.get("loop_period"),
+            "loop_diameter": metrics.get("loop_diameter"), "status": summary.get("status")}
 
 
 def trial_os(row: dict) -> float:
@@ -271,16 +277,23 @@ def orderings(study: NavigationStudy, cells: dict) -> list[Ordering]:
     return claims
 
 
-STALLED = 0.1  # a failed trial whose average velocity stayed under this share of v_gmax stalled; others wandered
+FAILURES = ("looping", "wandered", "stalled")  # tasks.missions.looping.failure_kind
 
 
 def failure_kinds(cell: Cell) -> str:
-    """How the cell's failed trials failed: stalled (barely moved) or wandered (kept moving, never arrived)."""
+    """How the cell's failed trials failed, counted by kind; loops with their median period and diameter."""
     failed = [r for r in cell.rows if not r["success"]]
-    if not failed:
-        return ""
-    stalled = sum(1 for r in failed if not r["avg_velocity"] >= STALLED)
-    return f"{stalled} stalled, {len(failed) - stalled} wandered"
+    parts = []
+    for kind in FAILURES:
+        of_kind = [r for r in failed if r["failure"] == kind]
+        if not of_kind:
+            continue
+        detail = ""
+        if kind == "looping":
+            detail = (f" (period {np.median([r['loop_period'] for r in of_kind]):.0f} s, "
+                      f"{np.median([r['loop_diameter'] for r in of_kind]):.1f} m across)")
+        parts.append(f"{len(of_kind)} {kind}{detail}")
+    return ", ".join(parts)
 
 
 def write_report(study: NavigationStudy, rows: list[dict], wall_s: float | None = None) -> None:
@@ -290,7 +303,8 @@ def write_report(study: NavigationStudy, rows: list[dict], wall_s: float | None 
     ran = f" {len(rows)} trials in {wall_s / 60:.0f} min on {study.workers or default_workers()} workers." \
         if wall_s is not None else ""
     lines = ["# Navigation study (Chand ch.3) re-run in teamsim", "",
-             f"{study.trials} trials per cell (the thesis: 100), {study.backend} backend;{ran} robots "
+             f"{study.trials} trials per cell (the thesis: 100), {study.backend} backend, {study.worlds} "
+             f"worlds;{ran} robots "
              f"{', '.join(study.robots)}; densities "
              f"{', '.join(f'{d:.0%}' for d in study.densities)}; controllers {', '.join(study.controllers)}. "
              "Trial k at a density uses the same world for every robot and controller. "
@@ -306,8 +320,9 @@ def write_report(study: NavigationStudy, rows: list[dict], wall_s: float | None 
         lines += [f"- **{'; '.join(claims)}**: {cause}" for cause, claims in causes.items()]
     lines += ["", "![overall score](os.png)", "", "## Cells", "",
               "NT, PI and AV are means over successful trials; ratios and p-values are against FRC on the same "
-              f"worlds (paired two-sided t-test). A failed trial stalled if its average velocity stayed under "
-              f"{STALLED:.0%} of v_gmax, and wandered otherwise.", "",
+              "worlds (paired two-sided t-test). Failures over their last 200 s (`tasks/missions/looping.py`): "
+              "stalled (mean speed under 10 % of v_max), looping (kept coming back to where it was: median period "
+              "and largest extent, medians over the cell's loops) or wandered.", "",
               "| robot | density | controller | NT (s) | PI | SR | AV | OS | OS/FRC | p | NT/FRC | p | failures | "
               "thesis (Figs 3.10-3.15) |",
               "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]

@@ -75,7 +75,7 @@ def _build_parser() -> argparse.ArgumentParser:
     navigation.add_argument("--robots", type=_csv_of("robot", ("A", "B", "C", "tricycle", "diffdrive", "tracked")))
     navigation.add_argument("--densities", type=_csv_of("density", None, float))
     navigation.add_argument("--controllers", type=_csv_of("controller", ("FRC", "HRDK", "HRDU", "ODW", "ODWDS",
-                                                                      "RFRC")))
+                                                                      "RFRC", "FRC-printed")))
     navigation.add_argument("--trials", type=_positive_int("--trials"))
     navigation.add_argument("--workers", type=_positive_int("--workers"))
     navigation.add_argument("--seed", type=int)
@@ -83,6 +83,9 @@ def _build_parser() -> argparse.ArgumentParser:
     navigation.add_argument("--backend", choices=("kinematic", "physics"),
                             help="kinematic (default: no dynamics, as the thesis simulated; minutes) or physics "
                                  "(every trial a MuJoCo navigate mission)")
+    navigation.add_argument("--worlds", choices=("strata", "uniform"),
+                            help="world family: strata (default: even, gaps at least Robot C's diameter) or uniform "
+                                 "(boxes anywhere, any size up to 1.6 m, overlapping)")
 
     two_tier = studies.add_parser("two-tier-astar", help="Chand ch.4: memory-constrained vs monolithic A*")
     two_tier.add_argument("--trials", type=_positive_int("--trials"), help="worlds per size and density")
@@ -168,7 +171,7 @@ def cmd_study(args) -> int:
             raise ConfigError("--densities: each must be in (0, 0.3]")
         study = study_from_args(robots=args.robots, densities=args.densities, controllers=args.controllers,
                                 trials=args.trials, workers=args.workers, out=args.out, seed=args.seed,
-                                backend=args.backend)
+                                backend=args.backend, worlds=args.worlds)
         out = run_study(study)
         print(f"wrote {out / 'report.md'} and {out / 'results.csv'}")
     elif args.study == "two-tier-astar":

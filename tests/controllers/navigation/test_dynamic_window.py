@@ -503,7 +503,7 @@ def test_frc_reaches_the_goal_in_a_five_percent_world(robot):
 def test_hrdk_follows_its_plan_to_the_goal():
     run, controller = crossing(HRDK, ROBOT_B)
     assert run.reached and not run.collided
-    assert controller.path_reaches_goal
+    assert controller.follower.reaches_goal
 
 
 def test_hrdu_maps_replans_and_reaches_the_goal():

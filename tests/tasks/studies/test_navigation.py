@@ -6,12 +6,14 @@ from pathlib import Path
 
 import pytest
 
-from teamsim.tasks.studies.navigation import (CAUSES, STALLED, NavigationStudy, at_most, cells_of, failure_kinds,
+from teamsim.tasks.studies.navigation import (CAUSES, NavigationStudy, at_most, cells_of, failure_kinds,
                                               orderings, sample_notes, write_report)
 
 
-def row(robot, density, controller, trial, success, avg_velocity=0.4, path_index=0.9):
-    return {"robot": robot, "density": density, "controller": controller, "trial": trial, "seed": trial,
+def row(robot, density, controller, trial, success, avg_velocity=0.4, path_index=0.9, failure="wandered",
+        loop=(None, None)):
+    return {"failure": "" if success else failure, "loop_period": loop[0], "loop_diameter": loop[1],
+            "robot": robot, "density": density, "controller": controller, "trial": trial, "seed": trial,
             "world_seed": trial, "success": success, "nav_time": 100.0, "path_index": path_index if success else 0.0,
             "avg_velocity": avg_velocity, "path_length": 20.0, "planned_length": 18.0,
             "status": "completed" if success else "failed"}
@@ -25,7 +27,8 @@ def study(tmp_path=Path("."), **kwargs):
 def rows():
     made = []
     for t in range(4):
-        made.append(row("A", 0.2, "FRC", t, t < 3, avg_velocity=0.05 if t == 3 else 0.4))  # 75 %: one stall
+        stalls = t == 3
+        made.append(row("A", 0.2, "FRC", t, not stalls, avg_velocity=0.05 if stalls else 0.4, failure="stalled"))
         made.append(row("B", 0.2, "FRC", t, True))
         for robot in ("A", "B"):
             made.append(row(robot, 0.2, "RFRC", t, True))
@@ -41,11 +44,11 @@ def test_orderings_name_a_cause_for_each_one_not_reproduced():
     assert found["RFRC ~ FRC except at high density"].verdict == "not measured"
 
 
-def test_failure_kinds_split_stalls_from_wandering():
-    cells = cells_of(rows() + [row("A", 0.2, "FRC", 4, False, avg_velocity=0.3)])
-    assert failure_kinds(cells[("A", 0.2, "FRC")]) == "1 stalled, 1 wandered"
+def test_failure_kinds_count_each_kind_and_give_the_loops_size():
+    loops = [row("A", 0.2, "FRC", t, False, failure="looping", loop=(period, 4.0)) for t, period in ((4, 18), (5, 22))]
+    cells = cells_of(rows() + [row("A", 0.2, "FRC", 6, False, avg_velocity=0.3)] + loops)
+    assert failure_kinds(cells[("A", 0.2, "FRC")]) == "2 looping (period 20 s, 4.0 m across), 1 wandered, 1 stalled"
     assert failure_kinds(cells[("B", 0.2, "FRC")]) == ""
-    assert STALLED == 0.1
 
 
 def test_report_lists_the_causes(tmp_path):

@@ -1,0 +1,129 @@
+"""Getting FRC out of the pockets it circles in (issue 22; docs/navigation.md, "Why FRC circles").
+
+FRC as printed (§3.6.2) is purely reactive: its direction sensor sees 1.5 m (d_obmax) and remembers nothing.
+In a pocket whose only opening faces away from the goal it drives to the pocket's closed end, turns back along
+it, and once the end lies beyond its sight, the goal-directedness term of (3.10) turns it round into the pocket
+again: a limit cycle of 15-40 s, for good. Breaking it needs memory, so this adds the smallest piece of it that
+the thesis itself uses for poor progress (the progress check of (3.6), re-planning in HRDU and §6.2):
+  - every IR hit is kept, for good, as an occupied cell of a world-frame grid (``HitMap``);
+  - the robot is **trapped** when ``period`` seconds have passed since its distance to the goal last fell by
+    ``progress`` (d_progmin of (3.6)) below its best;
+  - trapped, it plans a path to the goal with the modified A* (3.1)-(3.8) on the hits, unseen cells free,
+    obstacles inflated as HRD inflates them, or by the footprint alone where that leaves no way (from the
+    nearest cell outside the inflation when the robot stands beside a box), and follows it as HRD follows its plans (``path_following``), re-planning every ``replan`` seconds
+    with what it has since seen, until its distance to the goal falls by ``progress`` below its best: then it
+    is FRC again. A differential drive first turns in place to face each new plan (``TrapEscape.turn_first``).
+The thresholds are choices (docs/decisions.md, "FRC's trap escape").
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from teamsim.controllers.navigation.astar import PlannerParams, cost_maps, plan_on_grid
+from teamsim.controllers.navigation.occupancy_grid import OccupancyGrid
+from teamsim.controllers.navigation.path_following import PathFollower, PathFollowing
+
+
+@dataclass(frozen=True)
+class EscapeParams:
+    period: float = 30.0  # s without progress that make a trap (about two laps of the loops seen)
+    progress: float = 0.5  # m, d_progmin of (3.6)
+    replan: float = 20.0  # s between plans while escaping
+    facing: float = math.radians(30)  # a differential drive turns in place towards a new plan until within this
+    resolution: float = 0.1  # m, the hit grid's cell (the study's map resolution)
+    margin: float = 3.0  # m of free cells planned around the hits, the robot and the goal
+
+
+class HitMap:
+    """World-frame cells where the IR has ever seen an obstacle."""
+
+    def __init__(self, resolution: float):
+        self.resolution = resolution
+        self.cells: set[tuple[int, int]] = set()
+
+    def add(self, points: np.ndarray) -> None:
+        """Add obstacle points (m, 2), world frame."""
+        self.cells.update(map(tuple, np.floor(np.asarray(points) / self.resolution).astype(int).tolist()))
+
+    def grid(self, *keep: tuple[float, float], margin: float) -> OccupancyGrid:
+        """A known-map grid of the hits, spanning them and the ``keep`` points with ``margin`` round them."""
+        res = self.resolution
+        points = np.array([*((c[0] * res, c[1] * res) for c in self.cells), *keep]).reshape(-1, 2)
+        lo = np.floor((points.min(axis=0) - margin) / res).astype(int)
+        hi = np.floor((points.max(axis=0) + margin) / res).astype(int)
+        occupied = np.zeros((hi[1] - lo[1] + 1, hi[0] - lo[0] + 1), bool)
+        if self.cells:
+            cells = np.array(list(self.cells)) - lo
+            occupied[cells[:, 1], cells[:, 0]] = True
+        return OccupancyGrid.known((lo[0] * res, lo[1] * res), res, occupied)
+
+
+class TrapEscape:
+    """The trap detector and the escape plan of one robot driving to ``goal``; ``clearance`` is the planning
+    inflation beyond the footprint radius, as HRD's."""
+
+    def __init__(self, goal: tuple[float, float], radius: float, params: EscapeParams = EscapeParams(),
+                 following: PathFollowing = PathFollowing()):
+        self.goal = goal
+        self.radius = radius
+        self.params = params
+        self.following = following
+        self.hits = HitMap(params.resolution)
+        self.best = math.inf  # distance to the goal at the last progress
+        self.best_time = 0.0
+        self.follower: PathFollower | None = None
+        self.planned_at = -math.inf
+        self.escapes = 0  # plans made
+        self.turning = False  # turning in place towards a new plan
+
+    @property
+    def escaping(self) -> bool:
+        return self.follower is not None
+
+    def waypoint(self, time: float, centre: tuple[float, float]) -> tuple[float, float]:
+        """Where to aim: the goal, or while escaping the escape path's look-ahead point."""
+        distance = math.dist(centre, self.goal)
+        if distance <= self.best - self.params.progress or self.best == math.inf:
+            self.best, self.best_time = distance, time
+            self.follower = None
+        elif time - self.best_time >= self.params.period and (
+                not self.escaping or time - self.planned_at >= self.params.replan):
+            self._plan(time, centre)
+        return self.goal if self.follower is None else self.follower.waypoint(centre, self.goal)
+
+    def turn_first(self, heading: float) -> bool:
+        """Whether to stop and turn in place towards the plan's way (``heading``, relative to the robot) before
+        driving: after each new plan, until facing it. A slow robot with a small angular acceleration otherwise
+        prefers speed to turning (the speed term of (3.35) varies more across its window than the heading term)
+        and, next to boxes, can lock into a tight circle that only just clears them."""
+        self.turning = self.turning and self.escaping and abs(heading) > self.params.facing
+        return self.turning
+
+    def _plan(self, time: float, centre: tuple[float, float]) -> None:
+        """Plan with HRD's inflation (footprint radius plus clearance); where that leaves no way through, with the
+        footprint radius alone (the worlds guarantee only a way for the largest robot's own circle)."""
+        grid = self.hits.grid(centre, self.goal, margin=self.params.margin)
+        for inflation in (self.radius + self.following.clearance, self.radius):
+            start = self._free_start(grid, centre, inflation)
+            path, result = plan_on_grid(grid, start, self.goal, PlannerParams(), inflation)
+            if result.reached:
+                break
+        self.follower = PathFollower(np.vstack([centre, path]), result.reached, grid.resolution, self.following)
+        self.planned_at = time
+        self.escapes += 1
+        self.turning = True
+
+    def _free_start(self, grid: OccupancyGrid, centre: tuple[float, float], inflation: float) -> tuple[float, float]:
+        """Where the plan starts: the robot's centre, or, when that lies within the planning inflation of a hit
+        (beside a box), the nearest cell centre that does not; the dynamic window takes the robot there."""
+        blocked = cost_maps(grid.probabilities, PlannerParams(), inflation / grid.resolution).blocked
+        row, col = (int(i) for i in grid.world_to_cell(*centre))
+        if not blocked[row, col]:
+            return centre
+        free_rows, free_cols = np.nonzero(~blocked)
+        x, y = grid.cell_to_world(free_rows, free_cols)
+        nearest = int(np.argmin(np.hypot(x - centre[0], y - centre[1])))
+        return float(x[nearest]), float(y[nearest])
