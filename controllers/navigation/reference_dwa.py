@@ -157,10 +157,11 @@ def _braking_steps(fastest: float, brake: float, dt: float) -> int:
 
 
 def reference_decide(window: DynamicWindow, state: DriveState, points, heading: float, d_tgt: float,
-                     v_min_previous: float = 0.0) -> tuple[float, float, str, float]:
+                     v_min_previous: float = 0.0, v_cap: float = math.inf) -> tuple[float, float, str, float]:
     """FRC's decision, plainly: (v, omega, branch, v_min) for the next cycle, from the same arguments as
     ``window.decide`` (``points``: obstacle points relative to the robot's centre in the robot frame, any
-    sequence of (x, y); ``heading``: theta_tmod relative to the robot; ``d_tgt``: distance to the final goal)."""
+    sequence of (x, y); ``heading``: theta_tmod relative to the robot; ``d_tgt``: distance to the final goal;
+    ``v_cap``: teamsim's further speed limit, 0 while a trapped FRC turns to face its plan)."""
     if window.method is not Method.FRC:
         raise ValueError("reference_decide covers FRC only")
     p, lim, dt, radius, offset = window.params, window.limits, window.dt, window.radius, window.offset
@@ -178,7 +179,7 @@ def reference_decide(window: DynamicWindow, state: DriveState, points, heading: 
         if bearing >= math.pi - p.immediate_rear_half_angle:
             d_obirr = min(d_obirr, dist)
 
-    v_max = min(window.goal_speed_limit(d_tgt), window.obstacle_speed_limit(d_obfr))  # (3.18)
+    v_max = min(window.goal_speed_limit(d_tgt), v_cap, window.obstacle_speed_limit(d_obfr))  # (3.18)
     v_min = window.reverse_limit(d_obfr, d_obrr, d_obirr, v_min_previous)  # (3.23)
 
     # The linear window.

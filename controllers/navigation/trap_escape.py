@@ -1,18 +1,20 @@
 """Getting FRC out of the pockets it circles in (issue 22; docs/navigation.md, "Why FRC circles").
 
-FRC as printed (§3.6.2) is purely reactive: its direction sensor sees 1.5 m (d_obmax) and remembers nothing.
-In a pocket whose only opening faces away from the goal it drives to the pocket's closed end, turns back along
-it, and once the end lies beyond its sight, the goal-directedness term of (3.10) turns it round into the pocket
-again: a limit cycle of 15-40 s, for good. Breaking it needs memory, so this adds the smallest piece of it that
-the thesis itself uses for poor progress (the progress check of (3.6), re-planning in HRDU and §6.2):
+FRC as printed (§3.6.2) is purely reactive: its direction sensor sees 1.5 m (d_obmax) and its obstacle memory
+lasts seconds. Where the way to the goal is blocked by boxes it cannot see past, the sensor sends it round the
+clear side, the goal-directedness term of (3.10) brings it back to the same blocked gap once the boxes drop out
+of sight, and the robot drives the same 1-5 m loop every 15-40 s for good. Breaking it needs memory, so this
+adds the smallest piece of it that the thesis itself uses for poor progress (the progress check of (3.6),
+re-planning in HRDU and §6.2):
   - every IR hit is kept, for good, as an occupied cell of a world-frame grid (``HitMap``);
   - the robot is **trapped** when ``period`` seconds have passed since its distance to the goal last fell by
     ``progress`` (d_progmin of (3.6)) below its best;
   - trapped, it plans a path to the goal with the modified A* (3.1)-(3.8) on the hits, unseen cells free,
     obstacles inflated as HRD inflates them, or by the footprint alone where that leaves no way (from the
-    nearest cell outside the inflation when the robot stands beside a box), and follows it as HRD follows its plans (``path_following``), re-planning every ``replan`` seconds
-    with what it has since seen, until its distance to the goal falls by ``progress`` below its best: then it
-    is FRC again. A differential drive first turns in place to face each new plan (``TrapEscape.turn_first``).
+    nearest cell outside the inflation when the robot stands beside a box), and follows it as HRD follows its
+    plans (``path_following``), re-planning every ``replan`` seconds with what it has since seen, until its
+    distance to the goal falls by ``progress`` below its best: then it is FRC again. A differential drive first
+    turns in place to face each new plan (``TrapEscape.turn_first``).
 The thresholds are choices (docs/decisions.md, "FRC's trap escape").
 """
 from __future__ import annotations

@@ -213,6 +213,8 @@ class TwoTierResult:
     backtracks: int
     planning_time: float  # s, measured
     transmission_time: float  # s, of bytes_fetched at the link rate
+    expansions: int  # nodes the lower level took off its open lists, over every local plan: planning work
+    # that the machine's load does not change
 
     @property
     def overall_time(self) -> float:
@@ -278,12 +280,14 @@ def two_tier_astar(global_map: np.ndarray, start: tuple[int, int], goal: tuple[i
     found = None
     backtracks = 0
     best_partial = paths[first]
+    expansions = 0
 
     if first == final:
         rows, cols = partition.slices(first)
         local = memories.get(first, f)
         result = modified_astar(local, (start[0] - rows.start, start[1] - cols.start),
                                 (goal[0] - rows.start, goal[1] - cols.start), params.lower_level)
+        expansions += result.expanded
         if result.reached:
             paths[first] = result.cells + (rows.start, cols.start)
             found = first
@@ -332,6 +336,7 @@ def two_tier_astar(global_map: np.ndarray, start: tuple[int, int], goal: tuple[i
             for target in targets:
                 result = modified_astar(merged, local_start, (target[0] - origin[0], target[1] - origin[1]),
                                         params.lower_level)
+                expansions += result.expanded
                 if result.reached:
                     break
             else:
@@ -354,7 +359,7 @@ def two_tier_astar(global_map: np.ndarray, start: tuple[int, int], goal: tuple[i
         cells = best_partial
     bytes_fetched = memories.bytes_fetched
     return TwoTierResult(cells, found is not None, tuple(chain), bytes_fetched, memories.fetches, backtracks,
-                         time.perf_counter() - began, transmission_time(bytes_fetched, params.link_rate))
+                         time.perf_counter() - began, transmission_time(bytes_fetched, params.link_rate), expansions)
 
 
 def _chain(parent: dict, index: int) -> list[int]:

@@ -244,6 +244,14 @@ def kinematic_robot(robot: RobotModel) -> KinematicRobot:
     return KinematicRobot(robot.kind, robot.limits, robot.footprint_radius, len(radii), sensor_radius=radii)
 
 
+def kinematic_metrics(world: NavWorld, model: RobotModel, method: str, duration: float) -> dict:
+    """``nav_metrics`` of ``model`` driven by ``method`` through ``world`` without physics, with ``touches``."""
+    controller = navigation_controller(method, model, world)
+    run = kinematic_run(world, controller, kinematic_robot(model), duration, on_contact="stop")
+    metrics = nav_metrics(world, model, run.reached, run.pose, run.travelled, run.time, controller.trail)
+    return metrics | {"touches": run.touches}
+
+
 def kinematic_trial(config) -> dict:
     """A navigate trial without physics (``teamsim.tasks.worlds.navigation.kinematic_run``): the same world, robot
     dimensions, controller and measures as in physics, with ideal IR ranges and exact positioning. A motion that
@@ -252,13 +260,9 @@ def kinematic_trial(config) -> dict:
     params: NavigateParams = config.params
     params.check()
     rng = np.random.default_rng(params.world_seed if params.world_seed >= 0 else config.seed)
-    world = draw_world(params, rng)
     kind, options = robot_of(params.robot)
-    model = build_robot(kind, "red", **options)
-    controller = navigation_controller(params.controller, model, world)
-    run = kinematic_run(world, controller, kinematic_robot(model), time_limit(params.density), on_contact="stop")
-    metrics = nav_metrics(world, model, run.reached, run.pose, run.travelled, run.time, controller.trail)
-    metrics["touches"] = run.touches
+    metrics = kinematic_metrics(draw_world(params, rng), build_robot(kind, "red", **options), params.controller,
+                                time_limit(params.density))
     return {"mission": "navigate", "seed": config.seed, "run_id": config.run_id,
             "status": "completed" if metrics["success"] else "failed", "completed": metrics["success"],
-            "sim_time_s": run.time, "metrics": metrics}
+            "sim_time_s": metrics["nav_time"], "metrics": metrics}

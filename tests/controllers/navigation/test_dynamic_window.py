@@ -13,7 +13,8 @@ from hypothesis import strategies as st
 
 from teamsim.controllers.base import Observation
 from teamsim.controllers.navigation.dynamic_window import (FRC, HRDK, HRDU, ODW, ODWDS, RFRC, DriveState, DynamicWindow,
-                                                           DynamicWindowParams, Method, SteeringGeometry, _PoseTracker)
+                                                           DynamicWindowParams, Method, NO_CONTACT, SteeringGeometry,
+                                                           _PoseTracker)
 from teamsim.controllers.skills.locomotion import next_steer
 from teamsim.models.robot import DriveLimits
 from teamsim.positioning import PoseFix
@@ -430,12 +431,17 @@ def test_a_stalled_robot_starts_again_from_rest_and_not_into_what_stopped_it():
     assert free(observation(0.0, velocity=(0.0, 0.0))).v > 0.0  # the same robot at rest with nothing ahead
 
 
+def remember(controller, obs):
+    """What the controller remembers after this reading (no stall contact)."""
+    return controller._remember(obs.time, controller._seen(obs, NO_CONTACT))
+
+
 def test_obstacle_points_are_remembered_for_a_while():
     controller = FRC(LIMITS, "diffdrive", 0.35, goal=(5.0, 0.0), obstacle_memory=1.0)
-    points = controller._remember(observation(0.0, ranges=[1.0], bearings=[0.0]))
+    points = remember(controller, observation(0.0, ranges=[1.0], bearings=[0.0]))
     np.testing.assert_allclose(points, [[1.35, 0.0]])
-    assert len(controller._remember(observation(0.5, bearings=[0.0]))) == 1
-    assert len(controller._remember(observation(1.5, bearings=[0.0]))) == 0
+    assert len(remember(controller, observation(0.5, bearings=[0.0]))) == 1
+    assert len(remember(controller, observation(1.5, bearings=[0.0]))) == 0
 
 
 
@@ -443,13 +449,13 @@ def test_a_corner_seen_five_seconds_ago_is_still_remembered():
     # Robot B, kinematic 20 % world 20008: a box corner between two beams was last seen 5.3 s before the robot
     # turned into it; remembering 2 s, FRC had forgotten it.
     controller = FRC(LIMITS, "diffdrive", 0.35, goal=(5.0, 0.0))
-    controller._remember(observation(0.0, ranges=[1.0], bearings=[0.0]))
-    assert len(controller._remember(observation(5.5, bearings=[0.0]))) == 1
+    remember(controller, observation(0.0, ranges=[1.0], bearings=[0.0]))
+    assert len(remember(controller, observation(5.5, bearings=[0.0]))) == 1
 
 def test_obstacle_points_use_each_sensors_distance_from_the_centre():
     # A pentagon's sensors: the one looking forward sits on a vertex 0.5 m out, the one looking left on a side.
     controller = FRC(LIMITS, "diffdrive", 0.5, goal=(5.0, 0.0), sensor_radius=[0.5, 0.405])
-    points = controller._remember(observation(0.0, ranges=[1.0, 1.0], bearings=[0.0, math.pi / 2]))
+    points = remember(controller, observation(0.0, ranges=[1.0, 1.0], bearings=[0.0, math.pi / 2]))
     np.testing.assert_allclose(sorted(points.tolist()), [[0.0, 1.405], [1.5, 0.0]], atol=1e-9)
 
 

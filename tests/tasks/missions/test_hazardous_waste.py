@@ -45,7 +45,6 @@ def test_three_robots_clean_up_with_red_finding_the_locations(tmp_path):
     assert summary["robots"]["red"]["task_time_s"].get("find-locations-methodical", 0) > 30
     assert metrics["transports"] >= 5 and metrics["reports"] >= 1
     assert highest_puck(run_dir) > 0.1  # carried in the lifted gripper (the puck's centre rests at 0.019 m)
-    assert summary["real_time_factor"] > 1
 
 
 def test_a_teammate_takes_over_the_search_when_red_dies(tmp_path):

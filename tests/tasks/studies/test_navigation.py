@@ -6,8 +6,9 @@ from pathlib import Path
 
 import pytest
 
-from teamsim.tasks.studies.navigation import (CAUSES, NavigationStudy, at_most, cells_of, failure_kinds,
-                                              orderings, sample_notes, write_report)
+from teamsim.tasks.studies.navigation import (CAUSES, COLUMNS, NavigationStudy, at_most, binomial_p, cells_of,
+                                              failure_kinds, orderings, read_results, sample_notes, write_report,
+                                              write_results)
 
 
 def row(robot, density, controller, trial, success, avg_velocity=0.4, path_index=0.9, failure="wandered",
@@ -67,3 +68,33 @@ def test_what_one_trial_weighs_follows_the_sample_size():
     assert "8 of 10 or fewer in at least one of four cells 57 %" in sample_notes(10)["sample_success"]
     assert "88 of 100 or fewer" in sample_notes(100)["sample_success"]
     assert "about 0.01" in sample_notes(100)["sample_rfrc"]
+
+
+def test_results_read_back_as_written(tmp_path):
+    written = rows() + [row("A", 0.2, "FRC", 4, False, failure="looping", loop=(16.0, 1.75))]
+    for r in written:
+        r["touches"] = 0
+    write_results(tmp_path / "results.csv", written)
+    read = read_results(tmp_path / "results.csv")
+    assert [{k: r[k] for k in COLUMNS} for r in read] == [{k: r[k] for k in COLUMNS} for r in written]
+
+
+def test_a_claim_that_holds_in_some_cells_only_is_partly_reproduced_with_each_cells_p():
+    made = []
+    for t in range(4):
+        for density, hrdk_pi in ((0.1, 0.95), (0.2, 0.5)):  # HRDK better than FRC at 10 %, worse at 20 %
+            made.append(row("B", density, "FRC", t, True, path_index=0.9 - 0.01 * t))
+            made.append(row("B", density, "HRDK", t, True, path_index=hrdk_pi - 0.01 * t))
+    found = {o.claim: o for o in orderings(NavigationStudy(robots=("B",), densities=(0.1, 0.2),
+                                                           controllers=("FRC", "HRDK"), trials=4),
+                                           cells_of(made))}
+    hrdk = found["HRDK >= FRC in known worlds"]
+    assert hrdk.verdict == "partly" and hrdk.teamsim == "1 of 2 cells"
+    assert [(c.cell, c.holds) for c in hrdk.checks] == [("B 10%", True), ("B 20%", False)]
+    assert all(c.p < 0.05 for c in hrdk.checks)  # each difference is the same every trial: decided
+
+
+def test_success_rate_cells_carry_the_binomial_p_against_the_bound():
+    assert binomial_p(76, 100, 0.88, above=False) == pytest.approx(0.00064, abs=0.00002)  # docs/navigation.md
+    assert binomial_p(99, 100, 0.88, above=True) == pytest.approx(1 - at_most(98, 100, 0.88))
+    assert binomial_p(9, 10, 0.88, above=True) > 0.5  # 9 of 10 cannot tell 90 % from 88 %

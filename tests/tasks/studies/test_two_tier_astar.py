@@ -63,7 +63,7 @@ def row(nodes, density, planner, trial, **figures):
             "planner": "monolithic" if planner.monolithic else "two-tier",
             "local_map_kb": planner.local_map_kb, "memories": planner.memories, "cost_method": planner.cost_method,
             "planning_time": 1.0, "bytes_received": 1.0, "path_length": 1.0, "overall_time": 1.0,
-            "transmission_time": 0.0}
+            "transmission_time": 0.0, "expansions": 100}
     return {**base, **figures}
 
 
@@ -91,14 +91,17 @@ def test_claims_verdicts_on_made_up_rows():
                 # CM2 receives 20 % more everywhere; 64 KB is best; planning grows with density.
                 base = (1.0 if kb == 64 else 1.5) + noise
                 rows.append(row(500_000, d, Planner(kb, 1, 1), t, bytes_received=base, overall_time=base * 10,
-                                planning_time=d + noise))
+                                planning_time=d + noise, expansions=1000 * d + t))
                 rows.append(row(500_000, d, Planner(kb, 1, 2), t, bytes_received=1.2 * base,
-                                overall_time=base * 12, planning_time=d + noise))
+                                overall_time=base * 12, planning_time=d + noise, expansions=1100 * d + t))
     found = {c.claim: c for c in claims(study, Results(rows))}
     data = found["cost method 1 cheaper than 2: map data received"]
     assert (data.agree, data.total, data.verdict) == (4, 4, "yes")
     assert found["64 KB local maps do best (overall time)"].verdict == "yes"
     assert found["planning time grows with obstacle density (CM1, Q = 1)"].verdict == "yes"
+    assert found["planning work (node expansions) grows with obstacle density (CM1, Q = 1)"].verdict == "yes"
+    work = found["cost method 1 cheaper than 2: planning work (node expansions)"]
+    assert (work.agree, work.total, work.verdict) == (4, 4, "yes")
     # Two-tier / monolithic is about 1 for 64 KB (not significantly worse: comparable) and 1.5 for 128 KB (worse): the
     # thesis expects worse at 5 % and comparable at 25 %, so one cell of each size agrees.
     versus = found["memory-constrained vs monolithic overall time (CM1)"]
@@ -121,5 +124,5 @@ def test_tiny_study_end_to_end(tmp_path):
     again = run_study(study, tmp_path / "again", workers=1)
     with open(again["results"]) as handle:
         repeat = list(csv.DictReader(handle))
-    deterministic = ("bytes_received", "path_length", "fetches", "backtracks", "reached")
+    deterministic = ("bytes_received", "path_length", "fetches", "backtracks", "reached", "expansions")
     assert [[r[k] for k in deterministic] for r in rows] == [[r[k] for k in deterministic] for r in repeat]
