@@ -105,7 +105,7 @@ def test_turns_on_the_spot(direction):
     assert direction * turned > math.radians(45)
     # The commanded angle less the acceleration ramp; the gait compensates its feet's sideways slip.
     commanded = abs(omega) * seconds - omega ** 2 / (2 * DIMS.angular_accel_max)
-    assert abs(turned) == pytest.approx(commanded, rel=0.2)
+    assert abs(turned) == pytest.approx(commanded, rel=0.08)  # measured 0.95 of it either way (2026-11-26)
     assert math.dist(world.pose(red)[:2], start[:2]) < 0.05, "turns on the spot"
     assert warnings(world) == []
 
@@ -154,7 +154,8 @@ def test_wades_through_a_bog_at_its_traversability():
     start = world.pose(red)[0]
     run_for(world, 8.0)
     speed = (world.pose(red)[0] - start) / 8.0
-    assert speed == pytest.approx(DIMS.traversability * DIMS.v_max, rel=0.2)
+    # Measured 1.08 of it (2026-11-26): the legs' mean push over a stride is a little above max_traction.
+    assert speed == pytest.approx(DIMS.traversability * DIMS.v_max, rel=0.12)
     assert warnings(world) == []
 
 

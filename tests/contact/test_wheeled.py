@@ -71,8 +71,10 @@ def test_stops_within_its_deceleration_distance(kind):
     stopped = float(np.hypot(*(world.pose(red)[:2] - start)))
     limit = speed ** 2 / (2 * red.model.limits.accel_max)
     assert world.speed(red) < 0.01
-    # One control period of reaction at cruise speed on top of the braking distance.
-    assert stopped <= limit + speed * world.control_dt + 0.02
+    # One control period of reaction at cruise speed on top of the braking distance. The drives brake a little
+    # harder than accel_max (motor and rolling losses): measured 0.74, 0.87 and 0.63 of v^2 / 2a for diffdrive,
+    # tricycle and tracked (2026-11-26); a stop in under half of it would be a velocity jump, not braking.
+    assert 0.5 * limit <= stopped <= limit + speed * world.control_dt + 0.02
 
 
 @pytest.mark.parametrize("kind", WHEELED)
@@ -121,7 +123,9 @@ def test_ir_reads_a_wall_within_the_noise_model(kind):
         clean = float(ir.response(gap))
         sigma = float(np.interp(gap, ir.distances, ir.noise_fractions)) * clean + ir.resolution
         assert np.all(np.abs(raws - clean) <= 4 * sigma), (kind, gap, raws.min(), raws.max(), clean)
-        assert np.median(world.controllers["red"].observations[-1].ir_range[front]) == pytest.approx(gap, abs=0.15)
+        ranges = [o.ir_range[front] for o in world.controllers["red"].observations[5:]]
+        # The median of 25 noisy readings: measured within 0.018 m of the gap for every kind (2026-11-26).
+        assert np.median(ranges) == pytest.approx(gap, abs=0.03)
 
 
 def test_blinded_sensors_read_nothing():
