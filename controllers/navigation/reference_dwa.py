@@ -29,16 +29,50 @@ returns the same (v, omega) on every branch of the selection logic (Fig 3.7):
   7. otherwise that velocity with omega from the average curvature, or the hardest braking if that would move
      the centre towards a flagged point.
 
-The per-decision scalar limits (3.14), (3.17), (3.23) and the tricycle's curvature limits are FRC's own pure
-Python methods, called once a decision. Only FRC (not RFRC, ODW or ODWDS) is covered.
+It imports nothing from ``dynamic_window`` (issue 28): the scalar limits (3.14), (3.17), (3.23) and the
+tricycle's curvature limits are written here again from the equations, and of the window it is given only its
+numbers are read (parameters, drive limits, radius, offset, steering geometry, control period). Only FRC (not
+RFRC, ODW or ODWDS) is covered.
 """
 from __future__ import annotations
 
 import math
 
-from teamsim.controllers.navigation.dynamic_window import STEER_REQUEST, DriveState, DynamicWindow, Method
-
 TWO_PI = 2 * math.pi
+STEER_REQUEST = 0.01  # rad/s: the turn-only command that turns a standing tricycle's wheel (§3.5's "steer")
+
+
+def goal_speed_limit(p, v_gmax: float, d_tgt: float) -> float:
+    """(3.14) v_glmax: 0 within d_stop of the goal, falling linearly within d_decel, else v_gmax."""
+    if d_tgt <= p.d_stop:
+        return 0.0
+    return v_gmax * d_tgt / p.d_decel if d_tgt <= p.d_decel else v_gmax
+
+
+def obstacle_speed_limit(p, v_gmax: float, d_obfr: float) -> float:
+    """(3.17) v_obmax [RECON: continuous]: v_obmin up to d_obfrmin, rising linearly to v_gmax at d_obfrmax."""
+    if d_obfr <= p.d_obfrmin:
+        return p.v_obmin
+    if d_obfr > p.d_obfrmax:
+        return v_gmax
+    return p.v_obmin + (v_gmax - p.v_obmin) * (d_obfr - p.d_obfrmin) / (p.d_obfrmax - p.d_obfrmin)
+
+
+def reverse_limit(p, v_gmax: float, d_obfr: float, d_obrr: float, d_obirr: float, previous: float) -> float:
+    """(3.19)-(3.23) v_min [RECON]: no reversing with something close behind; back away (-v_gmax) when the front is
+    nearer than d_obfrT2; forward only beyond d_obfrT1; between the two, as before (hysteresis)."""
+    if d_obirr < p.d_obirrT or d_obrr < p.d_obrrT:
+        return 0.0
+    if d_obfr < p.d_obfrT2:
+        return -v_gmax
+    return 0.0 if d_obfr > p.d_obfrT1 else previous
+
+
+def curvature_limits(steering, dt: float, steer: float) -> tuple[float, float]:
+    """A tricycle's [c_min, c_max] = tan(delta) / L over the wheel angles delta reachable in one cycle."""
+    lo = max(steer - steering.steer_rate_max * dt, -steering.steer_max)
+    hi = min(steer + steering.steer_rate_max * dt, steering.steer_max)
+    return math.tan(lo) / steering.wheelbase, math.tan(hi) / steering.wheelbase
 
 
 def _clip(x: float, lo: float, hi: float) -> float:
@@ -112,7 +146,7 @@ def _collision_distance(v: float, omega: float, points: list[tuple[float, float,
     return min(travel, dc_max)
 
 
-def _stops_clear(v: float, omega: float, points: list[tuple[float, float, float]], window: DynamicWindow,
+def _stops_clear(v: float, omega: float, points: list[tuple[float, float, float]], window,
                  braking_steps: int) -> bool:
     """ST_v by integration, for one candidate: held one cycle, then braking at a_a along its curvature with omega
     slewed at the drive's angular limit, two cycles a step, for ``braking_steps`` steps (as many as the fastest
@@ -156,13 +190,14 @@ def _braking_steps(fastest: float, brake: float, dt: float) -> int:
             return steps
 
 
-def reference_decide(window: DynamicWindow, state: DriveState, points, heading: float, d_tgt: float,
+def reference_decide(window, state, points, heading: float, d_tgt: float,
                      v_min_previous: float = 0.0, v_cap: float = math.inf) -> tuple[float, float, str, float]:
     """FRC's decision, plainly: (v, omega, branch, v_min) for the next cycle, from the same arguments as
     ``window.decide`` (``points``: obstacle points relative to the robot's centre in the robot frame, any
     sequence of (x, y); ``heading``: theta_tmod relative to the robot; ``d_tgt``: distance to the final goal;
-    ``v_cap``: teamsim's further speed limit, 0 while a trapped FRC turns to face its plan)."""
-    if window.method is not Method.FRC:
+    ``v_cap``: teamsim's further speed limit, 0 while a trapped FRC turns to face its plan). ``window`` is read
+    for its numbers only; ``state`` is anything with v, omega and steer."""
+    if window.method.name != "FRC":
         raise ValueError("reference_decide covers FRC only")
     p, lim, dt, radius, offset = window.params, window.limits, window.dt, window.radius, window.offset
     pts = [(float(x), float(y)) for x, y in (points.tolist() if hasattr(points, "tolist") else points)]
@@ -179,8 +214,8 @@ def reference_decide(window: DynamicWindow, state: DriveState, points, heading: 
         if bearing >= math.pi - p.immediate_rear_half_angle:
             d_obirr = min(d_obirr, dist)
 
-    v_max = min(window.goal_speed_limit(d_tgt), v_cap, window.obstacle_speed_limit(d_obfr))  # (3.18)
-    v_min = window.reverse_limit(d_obfr, d_obrr, d_obirr, v_min_previous)  # (3.23)
+    v_max = min(goal_speed_limit(p, lim.v_max, d_tgt), v_cap, obstacle_speed_limit(p, lim.v_max, d_obfr))  # (3.18)
+    v_min = reverse_limit(p, lim.v_max, d_obfr, d_obrr, d_obirr, v_min_previous)  # (3.23)
 
     # The linear window.
     speed_up, slow_down = min(p.a_a, lim.accel_max) * dt, min(-p.a_d, lim.accel_max) * dt
@@ -191,7 +226,7 @@ def reference_decide(window: DynamicWindow, state: DriveState, points, heading: 
     # The angular window (3.24)-(3.25) and alpha_min.
     turn = lim.angular_accel_max * dt
     if window.tricycle:
-        c_min, c_max = window.curvature_limits(state.steer)
+        c_min, c_max = curvature_limits(window.steering, dt, state.steer)
         products = [c * vw for c in (c_min, c_max) for vw in (v_wmin, v_wmax)]
         w_min, w_max = min(products), max(products)
     else:
