@@ -12,7 +12,8 @@ on it (docs/decisions.md, "A second world family"):
     bring it (density measured as in ``random_world``);
   - a layout is kept only if a circle of ``passage_radius`` (Robot C's, the largest robot's, so that every robot
     shares the same worlds) can get from the start to the goal (``has_passage``); gaps narrower than a robot's
-    circle with its safety margin are allowed, as they are in any real room.
+    circle with its safety margin are allowed, as they are in any real room. At 20 % only about one layout in
+    60 passes, so the worlds there are those few: the family is harsher than its density alone says.
 """
 from __future__ import annotations
 
@@ -34,7 +35,8 @@ class UniformWorldParams:
     corner_margin: float = 1.5  # m from each wall to the start and the goal, as random_world
     clear_radius: float = 1.2  # m around the start and the goal kept free of obstacles
     passage_radius: float = 0.67  # m, Robot C's circle (Table 3.1)
-    layouts: int = 200  # layouts tried before giving up on a density
+    layouts: int = 2000  # layouts tried before giving up: at 20 % about one in 60 lets Robot C's disc through
+    # (measured on two seeds), and with 200 four seeds in 100 found none
     max_boxes: int = 2000  # drops per layout before it is given up
 
 
