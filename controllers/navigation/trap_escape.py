@@ -35,6 +35,7 @@ class EscapeParams:
     progress: float = 0.5  # m, d_progmin of (3.6)
     replan: float = 20.0  # s between plans while escaping
     facing: float = math.radians(30)  # a differential drive turns in place towards a new plan until within this
+    turning: float = 15.0  # s: and for no longer (a half turn at B's limits takes about 10 s)
     resolution: float = 0.1  # m, the hit grid's cell (the study's map resolution)
     margin: float = 3.0  # m of free cells planned around the hits, the robot and the goal
 
@@ -96,12 +97,14 @@ class TrapEscape:
             self._plan(time, centre)
         return self.goal if self.follower is None else self.follower.waypoint(centre, self.goal)
 
-    def turn_first(self, heading: float) -> bool:
-        """Whether to stop and turn in place towards the plan's way (``heading``, relative to the robot) before
-        driving: after each new plan, until facing it. A slow robot with a small angular acceleration otherwise
-        prefers speed to turning (the speed term of (3.35) varies more across its window than the heading term)
-        and, next to boxes, can lock into a tight circle that only just clears them."""
-        self.turning = self.turning and self.escaping and abs(heading) > self.params.facing
+    def turn_first(self, heading: float, time: float) -> bool:
+        """Whether to stop and turn in place towards the plan's way (``heading``: theta_tmod, relative to the
+        robot) before driving: after each new plan, until facing it, for at most ``turning`` seconds. A slow
+        robot with a small angular acceleration otherwise prefers speed to turning (the speed term of (3.35)
+        varies more across its window than the heading term) and, next to boxes, can lock into a tight circle
+        that only just clears them."""
+        self.turning = (self.turning and self.escaping and abs(heading) > self.params.facing
+                        and time - self.planned_at < self.params.turning)
         return self.turning
 
     def _plan(self, time: float, centre: tuple[float, float]) -> None:

@@ -73,6 +73,15 @@ def test_a_robot_beside_a_wall_plans_from_the_nearest_free_cell_and_turns_to_fac
     escape.waypoint(1.5, (1.5, 0.0))
     path = escape.follower.path
     assert tuple(path[0]) == (1.5, 0.0) and path[1][0] < 1.5  # first away from the wall
-    assert escape.turn_first(math.radians(90)) and escape.turn_first(math.radians(45))
-    assert not escape.turn_first(math.radians(20))  # facing it: drive
-    assert not escape.turn_first(math.radians(90))  # and only once per plan
+    assert escape.turn_first(math.radians(90), 1.6) and escape.turn_first(math.radians(45), 1.7)
+    assert not escape.turn_first(math.radians(20), 1.8)  # facing it: drive
+    assert not escape.turn_first(math.radians(90), 1.9)  # and only once per plan
+
+
+def test_turning_to_face_a_plan_gives_up_after_its_time():
+    escape = TrapEscape(goal=(4.0, 0.0), radius=0.35, params=EscapeParams(period=1.0, turning=15.0))
+    escape.hits.add(wall(2.0, -2.0, 2.0))
+    escape.waypoint(0.0, (1.0, 0.0))
+    escape.waypoint(1.5, (1.0, 0.0))  # planned at 1.5 s
+    assert escape.turn_first(math.radians(120), 16.0)
+    assert not escape.turn_first(math.radians(120), 16.6)  # 15 s on, still not facing it: drive anyway
