@@ -707,13 +707,12 @@ class DynamicWindowController:
         if self.arrived:
             return self._command(0.0, 0.0, "arrived")
         target = self.waypoint(pose, centre, obs)
-        heading = float(wrap(target_heading(*centre, *target) - pose[2]))
+        heading = bearing = float(wrap(target_heading(*centre, *target) - pose[2]))
         if self.method.uses_direction_sensor:
             previous = None if self.previous_direction is None else float(wrap(self.previous_direction - pose[2]))
             heading = modified_target_heading(points, heading, self.radius, self.direction, previous)
             self.previous_direction = heading + pose[2]
-        # Facing theta_tmod, the heading the window steers to: the plan's way as the direction sensor bends it.
-        turn_first = self.escape is not None and not self.window.tricycle and self.escape.turn_first(heading, obs.time)
+        turn_first = self.escape is not None and not self.window.tricycle and self.escape.turn_first(bearing, obs.time)
         decision = self.window.decide(self.state, points, heading, d_tgt, self.v_min, 0.0 if turn_first else math.inf)
         self.last_decision = decision
         self.v_min = decision.v_min

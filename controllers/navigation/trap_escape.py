@@ -98,8 +98,10 @@ class TrapEscape:
         return self.goal if self.follower is None else self.follower.waypoint(centre, self.goal)
 
     def turn_first(self, heading: float, time: float) -> bool:
-        """Whether to stop and turn in place towards the plan's way (``heading``: theta_tmod, relative to the
-        robot) before driving: after each new plan, until facing it, for at most ``turning`` seconds. A slow
+        """Whether to stop and turn in place towards the plan's way (``heading``: the bearing of its look-ahead
+        point, relative to the robot) before driving: after each new plan, until facing it, for at most
+        ``turning`` seconds (the window turns the robot towards theta_tmod, which the direction sensor can bend
+        more than ``facing`` away from that bearing: without the limit the robot then stood for good). A slow
         robot with a small angular acceleration otherwise prefers speed to turning (the speed term of (3.35)
         varies more across its window than the heading term) and, next to boxes, can lock into a tight circle
         that only just clears them."""
