@@ -110,19 +110,24 @@ def covered_cells(obstacle: Obstacle, centres: np.ndarray) -> np.ndarray:
 
 def random_world(density: float, rng: np.random.Generator, params: NavWorldParams = NavWorldParams()) -> NavWorld:
     """A world of the given obstacle density (a fraction), reproducible from ``rng``."""
+    return first_passable(density, rng, params, _layout)
+
+
+def first_passable(density: float, rng: np.random.Generator, params, layout) -> NavWorld:
+    """The first of up to ``params.layouts`` layouts drawn by ``layout(density, rng, params, (start, goal))`` that
+    reaches the density and lets a circle of ``params.passage_radius`` from the start to the goal; a layout that
+    jams short of the density (None) or leaves no passage is dropped and the next drawn."""
     half = params.size / 2
-    origin = (-half, -half)
     start = (-half + params.corner_margin, half - params.corner_margin)
     goal = (half - params.corner_margin, -half + params.corner_margin)
     heading = math.atan2(goal[1] - start[1], goal[0] - start[0])
-
-    # A layout that jams short of the density, or leaves no passage, is dropped and the next drawn.
     for _ in range(params.layouts):
-        layout = _layout(density, rng, params, (start, goal))
-        if layout is None:
+        drawn = layout(density, rng, params, (start, goal))
+        if drawn is None:
             continue
-        boxes, occupancy = layout
-        world = NavWorld(boxes, occupancy, origin, params.resolution, params.size, (start[0], start[1], heading), goal)
+        boxes, occupancy = drawn
+        world = NavWorld(boxes, occupancy, (-half, -half), params.resolution, params.size,
+                         (start[0], start[1], heading), goal)
         if has_passage(world, params.passage_radius):
             return world
     raise RuntimeError(f"could not reach {density:.0%} obstacle density with a passage for a "

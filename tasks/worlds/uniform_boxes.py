@@ -24,7 +24,7 @@ import numpy as np
 
 from teamsim.models.arenas import Box
 from teamsim.scenario import Obstacle
-from teamsim.tasks.worlds.navigation import NavWorld, cell_centres, covered_cells, has_passage
+from teamsim.tasks.worlds.navigation import NavWorld, cell_centres, covered_cells, first_passable
 
 
 @dataclass(frozen=True)
@@ -43,21 +43,7 @@ class UniformWorldParams:
 def uniform_world(density: float, rng: np.random.Generator,
                   params: UniformWorldParams = UniformWorldParams()) -> NavWorld:
     """A world of the given obstacle density (a fraction) in this family, reproducible from ``rng``."""
-    half = params.size / 2
-    start = (-half + params.corner_margin, half - params.corner_margin)
-    goal = (half - params.corner_margin, -half + params.corner_margin)
-    heading = math.atan2(goal[1] - start[1], goal[0] - start[0])
-    for _ in range(params.layouts):
-        layout = _layout(density, rng, params, (start, goal))
-        if layout is None:
-            continue
-        boxes, occupancy = layout
-        world = NavWorld(boxes, occupancy, (-half, -half), params.resolution, params.size,
-                         (start[0], start[1], heading), goal)
-        if has_passage(world, params.passage_radius):
-            return world
-    raise RuntimeError(f"could not reach {density:.0%} obstacle density with a passage for a "
-                       f"{params.passage_radius} m circle in {params.layouts} uniform layouts")
+    return first_passable(density, rng, params, _layout)
 
 
 def _layout(density: float, rng: np.random.Generator, params: UniformWorldParams,
