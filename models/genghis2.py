@@ -92,26 +92,32 @@ class Genghis2Dims:
     leg_masses: tuple[float, float, float] = (0.01, 0.03, 0.01)
     radio_mass: float = 0.12
     whisker_mass: float = 0.005
-    # Assumed servos: hobby-class position servos. Swing 0.3 N m (about 3 kg cm); lift 1.5 N m, since one leg
-    # of a tripod carries half the weight (7.4 N at the 0.104 m reach is 0.77 N m) and must also lift it.
-    swing_torque: float = 0.3
+    # Assumed servos: high-torque hobby position servos, 1.5 N m (about 15 kg cm) on both joints. The swing
+    # torque is what lets Genghis-II push the long box at all (Parker §6.1.1: it pushes, more weakly and slowly
+    # than an R-2): at 0.3 N m its stance tripod stalled at 5.4 N and an end of the box never moved; at 1.5 N m
+    # its feet slip first (friction 1.2 x 14.7 N of weight) and an end creeps (about 0.1 degree/s of box turn).
+    # Lift 1.5 N m, since one leg of a tripod carries half the weight (7.4 N at the 0.104 m reach is 0.77 N m)
+    # and must also lift it.
+    swing_torque: float = 1.5
     lift_torque: float = 1.5
     swing_gain: float = 10.0  # N m/rad
     lift_gain: float = 30.0  # N m/rad
     joint_damping: float = 0.05  # N m s/rad
     joint_armature: float = 0.002  # kg m^2, the servo's reflected rotor inertia
     # Mean horizontal push over a step cycle relative to the stance tripod's stall force (3 x swing_torque /
-    # reach = 8.7 N): a stance leg reaches stall only part-way through its stroke. Measured here: 5.4 N steady
-    # against the long heavy box. This sets max_traction, which calibrates bog drag.
-    push_efficiency: float = 0.6
+    # reach = 43 N): the feet slip before the servos stall. Calibrated so that it walks a bog at traversability x
+    # v_max (10.4 N while walking); standing against the long heavy box it pushes 13.8 N steady (measured).
+    # This sets max_traction, which calibrates bog drag.
+    push_efficiency: float = 0.24
     # Assumed gait (Parker gives none): tripod at 0.8 Hz, swing up to 0.3 rad, foot raised by 0.3 rad of lift.
     frequency: float = 0.8
     swing_max: float = 0.3
     lift_swing: float = 0.3
     # Turning, a two-DOF leg moves its foot only fore and aft, so the front and rear feet slip sideways and a
-    # tripod stepping the ideal differential stride turns at only about 60 % of the rate (measured here on the
-    # 1.0-1.2 friction floor). The gait steps 1/0.6 times harder to turn at the commanded rate.
-    turn_gain: float = 1.0 / 0.6
+    # tripod stepping the ideal differential stride turns at only about 75 % of the rate (measured here on the
+    # 1.0-1.2 friction floor; 60 % with 0.3 N m swing servos). The gait steps 1/0.75 times harder to turn at the
+    # commanded rate.
+    turn_gain: float = 1.0 / 0.75
     # Assumed command limits, well below the R-2's 0.457 m/s (§2.2.1): Genghis-II is the slower robot (§6.1.1).
     v_max: float = 0.08
     omega_max: float = 0.4  # rad/s; turning on the spot at this rate uses nearly the whole stride
