@@ -1,9 +1,12 @@
 """Faults as scenario data: what goes wrong, to which robot, and when (DESIGN.md, "Faults").
 
 CLI form: ``KIND:ROBOT@SECONDS[,key=value...]``, e.g. ``kill:red@60``, ``blind-ir:green@30``,
-``radio-off:blue@0``, ``slow:red@10,factor=0.5``, ``blind-ir:green@0,sensors=ir_left+ir_right``, ``break-motor:red@5,motor=left``,
-``add-robot:purple@20,kind=diffdrive``. The world applies each fault at its time and records an event; a
-fault only changes a robot's :class:`Health`, which the world consults when sensing and actuating.
+``radio-off:blue@0``, ``slow:red@10,factor=0.5``, ``blind-ir:green@0,sensors=ir_left+ir_right``,
+``break-motor:red@5,motor=left``, ``add-robot:purple@20,kind=diffdrive``, ``remove:red@60`` (taken out of the
+arena, as Parker seized an R-2, §6.1.2), ``revive:red@120`` (switched on again with a fresh controller; a removed
+robot is put back where the mission says, else at its start). The world applies each fault at its time and
+records an event; a fault only changes a robot's :class:`Health`, which the world consults when sensing and
+actuating.
 """
 from __future__ import annotations
 
@@ -23,6 +26,8 @@ FAULT_OPTIONS: dict[str, dict[str, tuple]] = {
     "slow": {"factor": (float, 0.5, "speed multiplier in (0, 1]")},
     "break-gripper": {},
     "add-robot": {"kind": (str, "diffdrive", "robot kind of the newcomer")},
+    "remove": {},
+    "revive": {},
 }
 FAULT_KINDS = tuple(FAULT_OPTIONS)
 _SPEC = re.compile(r"^(?P<kind>[a-z-]+):(?P<robot>[A-Za-z0-9_-]+)@(?P<time>[^,]+)(?P<rest>(,[^,=]+=[^,]*)*)$")
@@ -50,6 +55,7 @@ class Health:
     gripper_broken: bool = False
     speed_factor: float = 1.0
     broken_motors: set = field(default_factory=set)
+    removed: bool = False  # taken out of the arena (parked outside it) until revived
 
 
 def parse_fault(spec: str) -> Fault:
@@ -83,11 +89,15 @@ def parse_fault(spec: str) -> Fault:
 
 
 def apply_fault(fault: Fault, health: Health, motor_names: tuple[str, ...]) -> None:
-    """Change ``health`` as ``fault`` says (add-robot is the world's job: it has no health to change)."""
+    """Change ``health`` as ``fault`` says (add-robot is the world's job: it has no health to change; so is
+    moving a removed or revived robot)."""
     kind = fault.kind
-    if kind == "kill":
+    if kind in ("kill", "remove"):
         health.alive = False
         health.radio_on = False
+        health.removed = health.removed or kind == "remove"
+    elif kind == "revive":
+        health.alive = health.radio_on = True
     elif kind == "blind-ir":
         health.ir_blind += tuple(fault.options.get("sensors", "").split("+"))
     elif kind == "radio-off":

@@ -129,13 +129,13 @@ class MotivationRecorder:
         self._logged: dict[str, tuple[float, tuple]] = {}  # robot -> (time, levels) of its last logged sample
 
     def __call__(self, robot: str, time: float, trace: MotivationTrace) -> None:
-        sets = tuple(trace.motivation)
-        series = self.series.setdefault(robot, MotivationSeries(sets, float(trace.threshold)))
-        if sets != series.sets:
-            raise ValueError(f"motivation trace of {robot}: behaviour sets changed from {list(series.sets)} to "
-                             f"{list(sets)}")
+        series = self.series.setdefault(robot, MotivationSeries(tuple(trace.motivation), float(trace.threshold)))
+        sets = series.sets  # (a restarted controller may rank the same sets in another priority order)
+        if set(trace.motivation) != set(sets):
+            raise ValueError(f"motivation trace of {robot}: behaviour sets changed from {list(sets)} to "
+                             f"{list(trace.motivation)}")
         t = round(time, 6)
-        levels = tuple(round(float(m), 6) for m in trace.motivation.values())
+        levels = tuple(round(float(trace.motivation[s]), 6) for s in sets)
         series.times.append(time)
         series.levels.extend(levels)
         series.active.append(sets.index(trace.active) if trace.active is not None else -1)

@@ -152,6 +152,7 @@ class World:
         for robot in self.robots.values():
             self.radio.set_enabled(robot.name, robot.active)
         self.step = 0
+        self._restarts = 0
         mujoco.mj_forward(self.model, self.data)
 
     # -- set-up ---------------------------------------------------------------------------------------------
@@ -395,6 +396,9 @@ class World:
         robot = self.robots[fault.robot]
         if fault.kind == "add-robot":
             self._place(robot)
+        elif fault.kind == "revive":
+            apply_fault(fault, robot.health, robot.model.motors)
+            self._revive(robot)
         else:
             apply_fault(fault, robot.health, robot.model.motors)
             if fault.kind == "break-motor":
@@ -406,6 +410,8 @@ class World:
             if not robot.health.alive:
                 robot.drive.stop()
                 self.data.ctrl[robot.actuators] = robot.drive.targets(now)
+            if fault.kind == "remove":
+                self._move(robot, (PARKING_X + 3.0 * self._index_of[robot.name], 0.0, 0.0))
         self.radio.set_enabled(robot.name, robot.health.radio_on and not robot.dormant)
         self.record({"t": round(now, 6), "event": "fault", **fault.describe()})
 
@@ -416,12 +422,36 @@ class World:
             self.model.actuator_biasprm[actuator, :] = 0
 
     def _place(self, robot: Robot) -> None:
-        """Bring a dormant robot into the arena at its reserved spawn pose (the add-robot fault)."""
-        x, y, yaw = robot.spawn
+        """Bring a dormant robot into the arena (the add-robot fault): where the mission's ``entry_pose(world,
+        name)`` says, with a controller made for that place, or else at its reserved spawn pose."""
+        if hasattr(self.mission, "entry_pose"):
+            self._move(robot, self.mission.entry_pose(self, robot.name))
+            self._restart_controller(robot)
+        else:
+            self._move(robot, robot.spawn)
+        robot.dormant = False
+
+    def _revive(self, robot: Robot) -> None:
+        """Switch a robot on again (the revive fault) with a fresh controller, as after a power cycle; a removed
+        robot is first put back where the mission's ``entry_pose`` says (its start pose when it has none)."""
+        if robot.health.removed:
+            where = getattr(self.mission, "entry_pose", None)
+            self._move(robot, where(self, robot.name) if where else robot.spawn)
+            robot.health.removed = False
+        self._restart_controller(robot)
+
+    def _restart_controller(self, robot: Robot) -> None:
+        self._restarts += 1
+        stream = self.streams.get("robot", robot.name, "brain", "restart", str(self._restarts))
+        robot.controller = self.mission.controller(robot.model, self.scene, stream)
+        robot.drive = make_locomotion(robot.model.drive, robot.model.limits, self.control_dt)
+
+    def _move(self, robot: Robot, pose: tuple[float, float, float]) -> None:
+        """Set a robot down at (x, y, yaw), at rest."""
+        x, y, yaw = pose
         q = self.data.qpos
         q[robot.qpos_adr:robot.qpos_adr + 7] = [x, y, 0.002, math.cos(yaw / 2), 0, 0, math.sin(yaw / 2)]
         self.data.qvel[robot.qvel_adr:robot.qvel_adr + 6] = 0
-        robot.dormant = False
         robot.odometry_at = None
         mujoco.mj_forward(self.model, self.data)
 

@@ -1,0 +1,406 @@
+"""Parker's box pushing behaviour sets (§6.1, Figs 6-1 and 6-2; spec §4.2): R-2s and Genghis-II under ALLIANCE.
+
+A long heavy box is pushed across the room a little at a time, alternately at its two ends. The tasks are
+*push-left* and *push-right* (left and right as seen by a robot facing the box from behind). Every robot keeps
+:class:`PushKnowledge`: which end was pushed last, from its own pushes and from the "push complete" news that
+rides on every broadcast (R-2s cannot sense a teammate's push, §6.1.1). push-left is applicable while the right
+end was pushed after the left, in the order the robot learned of the pushes, and the reverse; at the start both
+are applicable ("every robot thinks the opposite end was just pushed").
+
+- R-2 (:class:`R2BoxPusher`, Fig. 6-1): push-left and push-right (:class:`PushEnd`), symmetric. An activation
+  acquires the end if the robot is not already there (back off, turn along the box, follow it with the side IR
+  to its end, back up, turn into the box), closes in with the fingertip IR, pushes for ``push_time`` keeping
+  square to the face with the fingertip IR, backs off a little, and records the push complete. Its own end's
+  set comes first in its priority order (the tie-break of §3.6: both sets cross theta together at the start).
+- Genghis-II (:class:`GenghisBoxPusher`, Fig. 6-2): *push* (applicable while a teammate is heard pushing the
+  opposite end) walks into its end, keeping square with its whiskers, for ``genghis_push_time``; *go-home*
+  (applicable while nobody is) walks back from the box. It never acquires the other end.
+
+Between pushes a robot announces the end it stands at as its activity (``push-left`` or ``push-right``), not
+"idle": see docs/decisions.md, "Box pushing: a robot between pushes announces its end". Rates and times the
+thesis does not give are in :class:`BoxPushParams`.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+
+from teamsim.config import setting
+from teamsim.controllers.alliance.motivation import (IDLE, AllianceController, AllianceParams,
+                                                     BehaviourSetDefinition, MotivationRates, activity_message,
+                                                     announced_task)
+from teamsim.controllers.base import Command, Observation
+from teamsim.controllers.skills.goto import DriveParams, steer_to, turn_to
+from teamsim.controllers.skills.pose_estimate import PoseEstimate
+from teamsim.models.r2 import TIP_IR
+from teamsim.models.robot import RobotModel
+
+LEFT, RIGHT = "left", "right"
+ENDS = (LEFT, RIGHT)
+OPPOSITE = {LEFT: RIGHT, RIGHT: LEFT}
+GO_HOME = "go-home"
+SIDE_IR = {LEFT: "ir_left_front", RIGHT: "ir_right_front"}
+WHISKERS = ("whisker_left", "whisker_right")
+
+
+def push_task(end: str) -> str:
+    return f"push-{end}"
+
+
+@dataclass(frozen=True)
+class BoxPushParams:
+    """Assumed constants of the box-pushing behaviours (§6.1 names the behaviours and the 5-8 s pause only)."""
+    push_time: float = setting(2.0, lo=0.1, meaning="s an R-2 pushes its end per push ('push a little', §6.1)")
+    push_speed: float = setting(0.3, lo=0.01, hi=0.45, meaning="m/s an R-2 is asked to drive into the box while "
+                                                               "pushing (it moves slower: the box is heavy)")
+    genghis_push_time: float = setting(10.0, lo=0.1, meaning="s Genghis-II walks into its end per push")
+    # delta_fast: 'the delay between pushes is from imperceptible to about 2 to 3 seconds, depending upon when the
+    # .3 Hz communication messages actually get transmitted' (§6.1.2): the radio sets the delay, not theta/delta.
+    fast_delay: float = setting(0.5, lo=0.01, meaning="theta / delta_fast, s: how soon an applicable push starts "
+                                                      "when nobody else does it")
+    # delta_slow_R(R-2) = theta / phi: the thesis's 'brief pause of about 5 to 8 seconds' (§6.1.2) before a
+    # survivor takes the other end over. It must outlast a teammate's push after its first message (<= 3 s of
+    # radio, 0.5 s, an approach and push_time): docs/decisions.md.
+    r2_patience: float = setting(7.0, lo=0.1, meaning="phi for an R-2 teammate, s: theta / delta_slow_R(R-2)")
+    # delta_slow_R(Genghis-II) < delta_slow_R(R-2) (§6.1.2): a Genghis-II push lasts genghis_push_time.
+    genghis_patience: float = setting(40.0, lo=0.1, meaning="phi for a Genghis-II teammate, s: theta / "
+                                                            "delta_slow_R(Genghis-II)")
+    acquiesce_after: float = setting(30.0, lo=0.1, meaning="psi, s active before yielding a push to a teammate "
+                                                           "heard doing it")
+    give_up_after: float = setting(60.0, lo=0.1, meaning="lambda, s active before giving a push up")
+    home_distance: float = setting(1.0, lo=0.1, meaning="m Genghis-II's go-home walks back from where it started")
+    drive: DriveParams = field(default_factory=lambda: DriveParams(cruise=0.15, turn_rate=1.0))
+    standoff: float = 0.12  # m backed off the face before turning along the box
+    follow_distance: float = 0.15  # m from the side IR to the face while following it
+    follow_gain: float = 3.0  # rad/s per m of following error
+    end_overrun: float = 0.04  # m driven on after the side IR loses the face: the end is passed
+    end_inset: float = 0.15  # m backed up from there: the robot pushes this far in from the end
+    contact_range: float = 0.03  # m: a fingertip reading nearer than this is contact
+    approach_timeout: float = 4.0  # s closing in before pushing anyway
+    square_gain: float = 2.0  # rad/s per m of difference between the two fingertip readings
+    whisker_gain: float = 0.02  # rad/s per N of difference between the two whiskers' contact forces
+    genghis_push_delay: float = 1.0  # s: theta / delta_fast_GP, Genghis-II's push (§6.1.1 gives no value)
+    go_home_delay: float = 2.0  # s: theta / delta_fast_GH
+    release_time: float = 0.5  # s backing off after a push, so the box can turn freely under the other end
+    follow_limit: float = 2.5  # m of following without finding the end: give the acquisition up and push here
+
+    def rates(self, delta_fast_delay: float, patience: float, teammates: dict[str, float]) -> MotivationRates:
+        """One set's rates: theta = 1, delta_slow = 1 / patience for every teammate (its kind's patience)."""
+        return MotivationRates(delta_fast=1 / delta_fast_delay, delta_slow=1 / patience, phi=patience,
+                               psi=self.acquiesce_after, lam=self.give_up_after,
+                               teammate_delta_slow=tuple((k, 1 / p) for k, p in teammates.items()),
+                               teammate_phi=tuple(teammates.items()))
+
+
+@dataclass
+class PushRecord:
+    """One push: who, which end, when the set was activated and when the push was complete."""
+    robot: str
+    end: str
+    activated: float
+    completed: float
+
+
+@dataclass
+class PushKnowledge:
+    """What this robot knows of the pushes: for each end, whether it was pushed and the opposite end has not been
+    pushed since, in the order this robot learned of them (its own pushes and the news it heard); and when each end
+    was last pushed, which is the news it passes on."""
+    fresh: dict = field(default_factory=lambda: dict.fromkeys(ENDS, True))  # at the start both count as just pushed
+    pushed_at: dict = field(default_factory=lambda: dict.fromkeys(ENDS, 0.0))
+    pushes: list = field(default_factory=list)  # this robot's own PushRecords
+
+    def applicable(self, end: str) -> bool:
+        """The opposite end was just pushed (Fig. 6-1's sensory feedback)."""
+        return self.fresh[OPPOSITE[end]]
+
+    def pushed(self, record: PushRecord) -> None:
+        self.pushes.append(record)
+        self._learn(record.end, record.completed)
+
+    def _learn(self, end: str, when: float) -> None:
+        if when > self.pushed_at[end]:
+            self.pushed_at[end] = when
+            self.fresh[end], self.fresh[OPPOSITE[end]] = True, False
+
+    def hear(self, payload) -> None:
+        """'push complete' news: a push at an end later than any this robot knew of."""
+        news = payload.get("pushed") if isinstance(payload, dict) else None
+        if isinstance(news, dict):
+            for end in sorted(ENDS, key=lambda e: float(news.get(e, 0.0))):  # the older news first
+                self._learn(end, float(news.get(end, 0.0)))
+
+    def message(self) -> dict:
+        """The news every broadcast carries: when each end was last pushed."""
+        return {"pushed": dict(self.pushed_at)}
+
+
+@dataclass
+class Station:
+    """Where an R-2 stands: the end it is at, and the heading that pushes into the box there."""
+    end: str
+    heading: float | None = None  # taken from the pose at the first push (the R-2 starts facing its end)
+
+
+def tip_ranges(obs: Observation, tips: list[int], cap: float) -> tuple[float, float]:
+    left, right = np.minimum(obs.ir_range[tips], cap)
+    return float(left), float(right)
+
+
+class PushEnd:
+    """One R-2 behaviour set of Fig. 6-1: acquire ``end`` if not there, push it a little, report it pushed."""
+
+    def __init__(self, robot: RobotModel, end: str, knowledge: PushKnowledge, station: Station,
+                 estimate: PoseEstimate, params: BoxPushParams):
+        self.robot, self.end, self.knowledge, self.station = robot.name, end, knowledge, station
+        self.estimate, self.params = estimate, params
+        self.tips = [robot.ir_sensors.index(n) for n in TIP_IR]
+        self.side_ir = {e: robot.ir_sensors.index(SIDE_IR[e]) for e in ENDS}
+        self.ir_range = robot.ir.max_range
+        self.name = push_task(end)
+        self.restart()
+
+    def restart(self) -> None:
+        self.state, self.since, self.mark = "start", None, None
+        self.seen, self.lost_at = False, None  # the side IR has seen the face; where it lost it
+
+    def __call__(self, obs: Observation) -> Command:
+        if self.since is None:
+            self.since = obs.time
+        if self.station.heading is None:
+            self.station.heading = float(self.estimate.pose[2])
+        return getattr(self, f"_{self.state}")(obs)
+
+    def _go(self, state: str, obs: Observation) -> Command:
+        self.state, self.mark = state, (obs.time, self.estimate.pose.copy())
+        return getattr(self, f"_{state}")(obs)
+
+    def _moved(self) -> float:
+        return float(np.hypot(*(self.estimate.pose[:2] - self.mark[1][:2])))
+
+    def _start(self, obs: Observation) -> Command:
+        return self._go("approach" if self.station.end == self.end else "back_off", obs)
+
+    # -- acquiring the end -----------------------------------------------------------------------------------
+    def _back_off(self, obs: Observation) -> Command:
+        if self._moved() >= self.params.standoff:
+            return self._go("turn_along", obs)
+        return self.drive(-self.params.drive.back_speed)
+
+    def along(self) -> float:
+        """Heading along the box towards this set's end: the left end lies to the left of the push heading."""
+        return self.station.heading + (math.pi / 2 if self.end == LEFT else -math.pi / 2)
+
+    def _turn_along(self, obs: Observation) -> Command:
+        omega = turn_to(self.estimate.pose, self.along(), self.params.drive, tolerance=0.05)
+        return self.drive(0.0, omega) if omega is not None else self._go("follow", obs)
+
+    def _follow(self, obs: Observation) -> Command:
+        """Drive along the face with it on the side away from the end (on the right going left), holding
+        ``follow_distance`` on that side's front IR, until that IR has lost the face for ``end_overrun``."""
+        p = self.params
+        side = OPPOSITE[self.end]
+        reading = obs.ir_range[self.side_ir[side]]
+        if math.isfinite(reading):
+            self.seen, self.lost_at = True, None
+            towards = -1.0 if side == RIGHT else 1.0
+            omega = towards * float(np.clip(p.follow_gain * (reading - p.follow_distance), -0.5, 0.5))
+            return self.drive(p.drive.cruise, omega)
+        if self.seen:
+            if self.lost_at is None:
+                self.lost_at = self.estimate.pose[:2].copy()
+            if np.hypot(*(self.estimate.pose[:2] - self.lost_at)) >= p.end_overrun:
+                return self._go("back_in", obs)
+        if self._moved() >= p.follow_limit:
+            return self._go("turn_in", obs)
+        return self.drive(p.drive.cruise, turn_to(self.estimate.pose, self.along(), p.drive, 0.02) or 0.0)
+
+    def _back_in(self, obs: Observation) -> Command:
+        if self._moved() >= self.params.end_overrun + self.params.end_inset:
+            return self._go("turn_in", obs)
+        return self.drive(-self.params.drive.back_speed)
+
+    def _turn_in(self, obs: Observation) -> Command:
+        omega = turn_to(self.estimate.pose, self.station.heading, self.params.drive, tolerance=0.05)
+        if omega is not None:
+            return self.drive(0.0, omega)
+        self.station.end = self.end
+        return self._go("approach", obs)
+
+    # -- pushing ---------------------------------------------------------------------------------------------
+    def square(self, obs: Observation) -> float:
+        """Turn rate that squares the jaw up to the face: towards the nearer fingertip reading."""
+        left, right = tip_ranges(obs, self.tips, self.ir_range)
+        return float(np.clip(self.params.square_gain * (right - left), -0.3, 0.3))
+
+    def _approach(self, obs: Observation) -> Command:
+        p = self.params
+        contact = min(tip_ranges(obs, self.tips, self.ir_range)) < p.contact_range
+        if contact or obs.touch.get("bump_front", 0.0) >= p.drive.bump_force or \
+                obs.time - self.mark[0] >= p.approach_timeout:
+            return self._go("push", obs)
+        return self.drive(p.push_speed, self.square(obs))
+
+    def _push(self, obs: Observation) -> Command:
+        p = self.params
+        if obs.time - self.mark[0] >= p.push_time:
+            self.station.heading = float(self.estimate.pose[2])
+            return self._go("release", obs)
+        return self.drive(p.push_speed, self.square(obs))
+
+    def _release(self, obs: Observation) -> Command:
+        if obs.time - self.mark[0] < self.params.release_time:
+            return self.drive(-self.params.drive.back_speed)
+        self.knowledge.pushed(PushRecord(self.robot, self.end, self.since, obs.time))
+        self.state = "done"
+        return self.drive()
+
+    def _done(self, obs: Observation) -> Command:
+        return self.drive()
+
+    def drive(self, v: float = 0.0, omega: float = 0.0) -> Command:
+        return Command(v=v, omega=omega, behaviour=self.name)
+
+
+class R2BoxPusher:
+    """One R-2's controller: push-knowledge, pose estimate and ALLIANCE over push-left and push-right, its own
+    end's set first (only that one if it does not ``acquire`` ends). ``teammates`` maps each teammate to its
+    patience phi (its kind's)."""
+
+    def __init__(self, robot: RobotModel, end: str, params: BoxPushParams, teammates: dict[str, float],
+                 acquires: bool = True, alliance: AllianceParams = AllianceParams()):
+        self.knowledge = PushKnowledge()
+        self.estimate = PoseEstimate(robot.drive)
+        self.station = Station(end)
+        rates = params.rates(params.fast_delay, params.r2_patience, teammates)
+        self.sets = {}
+        for e in (end, OPPOSITE[end]) if acquires else (end,):
+            self.sets[push_task(e)] = PushEnd(robot, e, self.knowledge, self.station, self.estimate, params)
+        definitions = [BehaviourSetDefinition(name, lambda obs, e=s.end: self.knowledge.applicable(e), s,
+                                              rates=rates) for name, s in self.sets.items()]
+        self.alliance = AllianceController(robot.name, definitions, alliance)
+        self.active = IDLE
+
+    @property
+    def pushes(self) -> list:
+        return self.knowledge.pushes
+
+    def __call__(self, obs: Observation) -> Command:
+        for message in obs.inbox:
+            self.knowledge.hear(message.payload)
+        if self.estimate.update(obs) is None:
+            return Command(behaviour=IDLE)
+        command = self.alliance(obs)
+        if command.behaviour != self.active:
+            if self.active in self.sets:
+                self.sets[self.active].restart()
+            self.active = command.behaviour
+        return announce(command, push_task(self.station.end), self.knowledge)
+
+
+def announce(command: Command, standing_task: str, knowledge: PushKnowledge) -> Command:
+    """The broadcast: the active set's task, or between pushes the end the robot stands at; and the push news."""
+    task = announced_task(command.broadcast) if command.behaviour != IDLE else standing_task
+    return replace(command, broadcast=activity_message(task, knowledge.message()))
+
+
+class GenghisPush:
+    """Fig. 6-2's *push*: walk into the box at this robot's end, square to it by the whiskers, for a given time."""
+
+    def __init__(self, robot: RobotModel, end: str, knowledge: PushKnowledge, params: BoxPushParams):
+        self.robot, self.end, self.knowledge, self.params = robot.name, end, knowledge, params
+        self.v_max = robot.limits.v_max
+        self.name = push_task(end)
+        self.restart()
+
+    def restart(self) -> None:
+        self.since = self.touched = None
+        self.done = False
+
+    def __call__(self, obs: Observation) -> Command:
+        p = self.params
+        if self.since is None:
+            self.since = obs.time
+        left, right = (obs.touch.get(w, 0.0) for w in WHISKERS)
+        if self.touched is None and (left > 0.0 or right > 0.0 or obs.time - self.since >= 2 * p.approach_timeout):
+            self.touched = obs.time
+        if self.touched is not None and obs.time - self.touched >= p.genghis_push_time:
+            if obs.time - self.touched < p.genghis_push_time + p.release_time:
+                return Command(v=-self.v_max, behaviour=self.name)
+            if not self.done:
+                self.knowledge.pushed(PushRecord(self.robot, self.end, self.since, obs.time))
+                self.done = True
+            return Command(behaviour=self.name)
+        omega = float(np.clip(p.whisker_gain * (left - right), -0.2, 0.2))
+        return Command(v=self.v_max, omega=omega, behaviour=self.name)
+
+
+class GoHome:
+    """Fig. 6-2's *go-home*: walk back to a point ``home_distance`` behind where the robot started."""
+    name = GO_HOME
+
+    def __init__(self, params: BoxPushParams, v_max: float, omega_max: float):
+        self.params = params
+        self.drive = replace(params.drive, cruise=v_max, turn_rate=omega_max)
+        self.home: np.ndarray | None = None
+
+    def restart(self) -> None:
+        pass
+
+    def place(self, fix) -> None:
+        if self.home is None:
+            self.home = np.array([fix.x, fix.y]) - self.params.home_distance * np.array(
+                [math.cos(fix.heading), math.sin(fix.heading)])
+
+    def __call__(self, obs: Observation) -> Command:
+        fix = obs.pose
+        step = steer_to(np.array([fix.x, fix.y, fix.heading]), self.home, self.drive, arrive=0.2)
+        v, omega = step or (0.0, 0.0)
+        return Command(v=v, omega=omega, behaviour=self.name)
+
+
+class GenghisBoxPusher:
+    """Genghis-II's controller (Fig. 6-2): ALLIANCE over push (its end) and go-home. A teammate is pushing the
+    opposite end while it was heard announcing that end's task within tau."""
+
+    def __init__(self, robot: RobotModel, end: str, params: BoxPushParams, alliance: AllianceParams = AllianceParams()):
+        self.knowledge = PushKnowledge()
+        self.end, self.tau = end, alliance.tau
+        self.heard: dict[str, tuple[str | None, float]] = {}  # teammate -> (announced task, when)
+        self.push = GenghisPush(robot, end, self.knowledge, params)
+        self.home = GoHome(params, robot.limits.v_max, robot.limits.omega_max)
+        self.sets = {self.push.name: self.push, GO_HOME: self.home}
+        rates = params.rates(params.genghis_push_delay, params.r2_patience, {})
+        definitions = [
+            BehaviourSetDefinition(self.push.name, lambda obs: self.opposite_pushed(obs) and not self.push.done,
+                                   self.push, rates=rates),
+            BehaviourSetDefinition(GO_HOME, lambda obs: not self.opposite_pushed(obs), self.home,
+                                   rates=params.rates(params.go_home_delay, params.r2_patience, {}))]
+        self.alliance = AllianceController(robot.name, definitions, alliance)
+        self.active = IDLE
+
+    @property
+    def pushes(self) -> list:
+        return self.knowledge.pushes
+
+    def opposite_pushed(self, obs: Observation) -> bool:
+        task = push_task(OPPOSITE[self.end])
+        return any(t == task and obs.time - when < self.tau for t, when in self.heard.values())
+
+    def __call__(self, obs: Observation) -> Command:
+        for message in obs.inbox:
+            self.knowledge.hear(message.payload)
+            self.heard[message.sender] = (announced_task(message.payload), obs.time)
+        if obs.pose is None:
+            return Command(behaviour=IDLE)
+        self.home.place(obs.pose)
+        command = self.alliance(obs)
+        if command.behaviour != self.active:
+            if self.active in self.sets:
+                self.sets[self.active].restart()
+            self.active = command.behaviour
+        standing = GO_HOME if self.active == GO_HOME else push_task(self.end)
+        return announce(command, standing, self.knowledge)
+
