@@ -58,12 +58,13 @@ class BoxPushParams:
     genghis_push_time: float = setting(10.0, lo=0.1, meaning="s Genghis-II walks into its end per push")
     # delta_fast: 'the delay between pushes is from imperceptible to about 2 to 3 seconds, depending upon when the
     # .3 Hz communication messages actually get transmitted' (§6.1.2): the radio sets the delay, not theta/delta.
-    fast_delay: float = setting(0.5, lo=0.01, meaning="theta / delta_fast, s: how soon an applicable push starts "
+    fast_delay: float = setting(0.3, lo=0.01, meaning="theta / delta_fast, s: how soon an applicable push starts "
                                                       "when nobody else does it")
-    # delta_slow_R(R-2) = theta / phi: the thesis's 'brief pause of about 5 to 8 seconds' (§6.1.2) before a
-    # survivor takes the other end over. It must outlast a teammate's push after its first message (<= 3 s of
-    # radio, 0.5 s, an approach and push_time): docs/decisions.md.
-    r2_patience: float = setting(7.0, lo=0.1, meaning="phi for an R-2 teammate, s: theta / delta_slow_R(R-2)")
+    # delta_slow_R(R-2) = theta / phi sets the pause before a survivor takes the other end over (§6.1.2: 'about
+    # 5 to 8 seconds'). It must outlast a live teammate's whole turn, up to 9 s from this robot's own push (two
+    # radio waits of up to 3 s, fast_delay, an approach, push_time, release_time): with 7 s a healthy robot was
+    # taken over (docs/decisions.md).
+    r2_patience: float = setting(10.0, lo=0.1, meaning="phi for an R-2 teammate, s: theta / delta_slow_R(R-2)")
     # delta_slow_R(Genghis-II) < delta_slow_R(R-2) (§6.1.2): a Genghis-II push lasts genghis_push_time.
     genghis_patience: float = setting(40.0, lo=0.1, meaning="phi for a Genghis-II teammate, s: theta / "
                                                             "delta_slow_R(Genghis-II)")
@@ -74,7 +75,8 @@ class BoxPushParams:
     drive: DriveParams = field(default_factory=lambda: DriveParams(cruise=0.15, turn_rate=1.0))
     standoff: float = 0.12  # m backed off the face before turning along the box
     follow_distance: float = 0.15  # m from the side IR to the face while following it
-    follow_gain: float = 3.0  # rad/s per m of following error
+    follow_gain: float = 3.0  # rad of heading bend per m of following error
+    follow_bend: float = 0.3  # rad: the most the heading bends from along the box while following it
     end_overrun: float = 0.04  # m driven on after the side IR loses the face: the end is passed
     end_inset: float = 0.15  # m backed up from there: the robot pushes this far in from the end
     contact_range: float = 0.03  # m: a fingertip reading nearer than this is contact
@@ -83,7 +85,7 @@ class BoxPushParams:
     whisker_gain: float = 0.02  # rad/s per N of difference between the two whiskers' contact forces
     genghis_push_delay: float = 1.0  # s: theta / delta_fast_GP, Genghis-II's push (§6.1.1 gives no value)
     go_home_delay: float = 2.0  # s: theta / delta_fast_GH
-    release_time: float = 0.5  # s backing off after a push, so the box can turn freely under the other end
+    release_time: float = 0.3  # s backing off after a push, so the box can turn freely under the other end
     follow_limit: float = 2.5  # m of following without finding the end: give the acquisition up and push here
 
     def rates(self, delta_fast_delay: float, patience: float, teammates: dict[str, float]) -> MotivationRates:
@@ -105,9 +107,8 @@ class PushRecord:
 
 @dataclass
 class PushKnowledge:
-    """What this robot knows of the pushes: for each end, whether it was pushed and the opposite end has not been
-    pushed since, in the order this robot learned of them (its own pushes and the news it heard); and when each end
-    was last pushed, which is the news it passes on."""
+    """What this robot knows of the pushes (its own, and the news it heard): when each end was last pushed, which
+    is the news it passes on; and for each end, whether it was pushed last."""
     fresh: dict = field(default_factory=lambda: dict.fromkeys(ENDS, True))  # at the start both count as just pushed
     pushed_at: dict = field(default_factory=lambda: dict.fromkeys(ENDS, 0.0))
     pushes: list = field(default_factory=list)  # this robot's own PushRecords
@@ -121,9 +122,13 @@ class PushKnowledge:
         self._learn(record.end, record.completed)
 
     def _learn(self, end: str, when: float) -> None:
+        """A push at ``end`` completed at ``when``. It is the latest push unless the other end was pushed later
+        (news can arrive after news of a later push: the radio sends at each robot's own slot); at equal times,
+        the robots having pushed both ends together, it is the latest push for the robot learning it last."""
         if when > self.pushed_at[end]:
             self.pushed_at[end] = when
-            self.fresh[end], self.fresh[OPPOSITE[end]] = True, False
+            if when >= self.pushed_at[OPPOSITE[end]]:
+                self.fresh[end], self.fresh[OPPOSITE[end]] = True, False
 
     def hear(self, payload) -> None:
         """'push complete' news: a push at an end later than any this robot knew of."""
@@ -204,9 +209,14 @@ class PushEnd:
         side = OPPOSITE[self.end]
         reading = obs.ir_range[self.side_ir[side]]
         if math.isfinite(reading):
+            # Steer for a heading along the box bent towards it (or away) by the distance error, at most
+            # follow_bend: steering on the error alone turned the robot into the face, where the oblique ray reads
+            # long and asks for more turn (a robot wedged itself against the box for 60 s, seed 100).
             self.seen, self.lost_at = True, None
             towards = -1.0 if side == RIGHT else 1.0
-            omega = towards * float(np.clip(p.follow_gain * (reading - p.follow_distance), -0.5, 0.5))
+            bend = towards * float(np.clip(p.follow_gain * (reading - p.follow_distance), -p.follow_bend,
+                                           p.follow_bend))
+            omega = turn_to(self.estimate.pose, self.along() + bend, p.drive, tolerance=0.0) or 0.0
             return self.drive(p.drive.cruise, omega)
         if self.seen:
             if self.lost_at is None:

@@ -208,5 +208,6 @@ class BoxPushingMission(ScenarioMission):
             "pushes": len(pushes),
             "pushes_per_robot": per_robot,
             "push_log": [[p.robot, p.end, round(p.activated, 2), round(p.completed, 2)] for p in pushes],
+            "final_behaviour": {n: r.behaviour if r.active else "off" for n, r in world.robots.items()},
         }
         return advance >= world.scene.scenario.task.advance, metrics

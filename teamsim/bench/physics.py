@@ -13,6 +13,8 @@ cleanup: the 3-robot hazardous-waste mission's real-time factor (the issue's tar
 with resting objects asleep (as shipped, see :func:`teamsim.models.arenas.walled_room`) and with sleeping
 switched off on the same world, and the ratio of the two.
 
+box-pushing: the box-pushing mission with two R-2s and Genghis-II, real-time factor (target >= 20x, no video).
+
 render: frames/s at 640x480 for a 5-robot scene: the MuJoCo render alone, with the HUD, and with the HUD
 and H.264 encoding (the whole live video path).
 """
@@ -26,8 +28,10 @@ import mujoco
 import numpy as np
 
 from teamsim.config import TrialConfig
+from teamsim.faults import Fault
 from teamsim.recording import TrajectoryRecorder
 from teamsim.runner import simulate
+from teamsim.scenario import resolve
 from teamsim.tasks import MISSIONS
 from teamsim.world import World
 
@@ -152,6 +156,20 @@ def cleanup(seconds: float = 300.0, seed: int = 9) -> dict:
     print(f"  resting objects asleep  {result['sleep_rtf']:6.1f}x real time   (target >= 20x)")
     print(f"  every body awake        {result['awake_rtf']:6.1f}x real time")
     print(f"  ratio                   {result['ratio']:6.2f}")
+    return result
+
+
+def box_pushing(seconds: float = 120.0, seed: int = 0) -> dict:
+    """Two R-2s pushing the box with Genghis-II (its twelve leg servos stepping a gait) joining behind it at t = 0,
+    full control stack, no video (issue 23's target: >= 20x real time)."""
+    mission = MISSIONS["box-pushing"]
+    config = TrialConfig(mission="box-pushing", params=mission.Params(), seed=seed,
+                         faults=[Fault("add-robot", "genghis", 0.0, {"kind": "genghis2"})])
+    world = World(resolve(config, mission), mission)
+    print(f"bench box-pushing: red and green (R-2s) and genghis (Genghis-II), seed {seed}, {seconds:g} s simulated, "
+          "full control stack, no video")
+    result = {"rtf": stack_steps_per_second(world, seconds) * world.physics_dt}
+    print(f"  {result['rtf']:6.1f}x real time   (target >= 20x)")
     return result
 
 

@@ -15,6 +15,7 @@ from teamsim.gl import RenderBackendError
 
 # teamsim.tasks.studies.cleanup_faults.CONDITIONS, spelled out so that building the parser imports no physics
 CLEANUP_CONDITIONS = ("none", "kill-red", "radio-off", "break-gripper")
+BOX_EXPERIMENTS = ("robot-failure", "heterogeneity")  # teamsim.tasks.studies.box_pushing.EXPERIMENTS
 
 EXIT_USAGE = 2
 
@@ -113,8 +114,18 @@ def _build_parser() -> argparse.ArgumentParser:
     faults.add_argument("--seed", type=int, default=0)
     faults.add_argument("--out", type=Path, default=Path("renders/study-cleanup-faults"))
 
+    boxes = studies.add_parser("box-pushing", help="Parker §6.1.2: an R-2 taken away and returned; an R-2 replaced "
+                                                   "by Genghis-II")
+    boxes.add_argument("--trials", type=_positive_int("--trials"), default=20, help="trials per experiment")
+    boxes.add_argument("--experiments", type=_csv_of("experiment", BOX_EXPERIMENTS), default=BOX_EXPERIMENTS,
+                       help=f"comma-separated: {','.join(BOX_EXPERIMENTS)}")
+    boxes.add_argument("--workers", type=_positive_int("--workers"), default=2)
+    boxes.add_argument("--seed", type=int, default=0)
+    boxes.add_argument("--out", type=Path, default=Path("renders/study-box-pushing"))
+
     bench = commands.add_parser("bench", help="benchmarks")
-    bench.add_argument("what", choices=("physics", "cleanup", "render", "nav", "alliance", "allocate", "sweep"))
+    bench.add_argument("what", choices=("physics", "cleanup", "box-pushing", "render", "nav", "alliance", "allocate",
+                                        "sweep"))
     bench.add_argument("--seconds", type=float, default=None, help="simulated seconds per measurement")
     return parser
 
@@ -193,6 +204,12 @@ def cmd_study(args) -> int:
 
         out = run_study(CleanupFaultStudy(missions=args.missions, seed=args.seed, conditions=args.conditions,
                                           workers=args.workers, out=args.out))
+        print(f"wrote {out / 'report.md'} and {out / 'results.csv'}")
+    elif args.study == "box-pushing":
+        from teamsim.tasks.studies.box_pushing import BoxPushingStudy, run_study
+
+        out = run_study(BoxPushingStudy(trials=args.trials, seed=args.seed, experiments=args.experiments,
+                                        workers=args.workers, out=args.out))
         print(f"wrote {out / 'report.md'} and {out / 'results.csv'}")
     elif args.study == "lalliance":
         from teamsim.tasks.studies.lalliance import run_study
@@ -273,6 +290,7 @@ def cmd_list(_args) -> int:
     print("  lalliance        Parker §4.5: L-ALLIANCE strategies I-IV, abstract (no physics)")
     print("  awareness        Parker ch.5: the cleanup with and without awareness, versions I-IV")
     print("  cleanup-faults   Parker §3.8.4: the cleanup with red killed, the radio off, a gripper broken")
+    print("  box-pushing      Parker §6.1.2: an R-2 taken away and returned; an R-2 replaced by Genghis-II")
     return 0
 
 
@@ -324,6 +342,8 @@ def cmd_bench(args) -> int:
         bench.robot_kinds(seconds=args.seconds or 10.0)
     elif args.what == "cleanup":
         bench.cleanup(seconds=args.seconds or 300.0)
+    elif args.what == "box-pushing":
+        bench.box_pushing(seconds=args.seconds or 120.0)
     else:
         from teamsim.bench.video import video_cost
 

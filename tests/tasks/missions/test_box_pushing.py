@@ -1,0 +1,287 @@
+"""End to end: Parker's box pushing in physics (§6.1), through the real World, with fixed seeds.
+
+What the thesis reports and these tests check: two R-2s push the ends of the long box in turn, each its own end,
+and the box crosses the room square; when one R-2 is taken away the other, after a brief pause (§6.1.2: "about
+5 to 8 seconds"), pushes both ends; when it is put back they share the ends again; with Genghis-II in its place
+the R-2 pushes less often (Genghis-II's push is slow) and Genghis-II goes home once the R-2 is gone (Fig. 6-2).
+And bad input (an unknown robot in a fault, a box that cannot advance that far, a Genghis-II asked to acquire an
+end) is one line and exit status 2.
+
+The mission runs 20-30x real time; each trial is run once (functools.cache) and read by several tests.
+"""
+from __future__ import annotations
+
+import functools
+import math
+from itertools import pairwise
+from dataclasses import dataclass
+
+import pytest
+import yaml
+
+from teamsim.config import ConfigError, TrialConfig
+from teamsim.controllers.behaviours.box_pushing import GO_HOME, LEFT, RIGHT, BoxPushParams
+from teamsim.faults import Health, apply_fault, parse_fault
+from teamsim.scenario import resolve
+from teamsim.tasks import MISSIONS
+from teamsim.tasks.missions.box_pushing import STAND_BACK
+from teamsim.world import World
+
+MISSION = MISSIONS["box-pushing"]
+SEED = 1
+PARAMS = BoxPushParams()
+
+
+@dataclass(frozen=True)
+class Push:
+    robot: str
+    end: str
+    activated: float
+    completed: float
+
+
+@dataclass
+class Trial:
+    world: World
+    metrics: dict
+    pushes: list  # every completed Push, in order of completion
+    events: list  # the world's events (behaviour changes, faults, radio)
+
+    def of(self, robot: str, since: float = 0.0, until: float = math.inf) -> list[Push]:
+        """robot's pushes activated in [since, until)."""
+        return [p for p in self.pushes if p.robot == robot and since <= p.activated < until]
+
+    def behaviour_changes(self, robot: str) -> list[tuple[float, str]]:
+        return [(e["t"], e["to"]) for e in self.events if e["event"] == "behaviour" and e["robot"] == robot]
+
+
+@functools.cache
+def trial(seed: int, duration: float, *faults: str) -> Trial:
+    events = []
+    config = resolve(TrialConfig(mission="box-pushing", params=MISSION.Params(), seed=seed,
+                                 faults=[parse_fault(f) for f in faults]), MISSION)
+    world = World(config, MISSION, events=events.append)
+    while world.time < duration - 1e-9:
+        world.tick()
+        world.advance(world.steps_per_tick)
+    _, metrics = MISSION.outcome(world)
+    return Trial(world, metrics, [Push(*p) for p in metrics["push_log"]], events)
+
+
+def no_faults() -> Trial:
+    return trial(SEED, 60.0)
+
+
+TAKEOVER = ("remove:green@30", "revive:green@90")
+
+
+def takeover() -> Trial:
+    return trial(SEED, 200.0, *TAKEOVER)
+
+
+GENGHIS = ("remove:green@40", "add-robot:genghis@40,kind=genghis2", "remove:red@160")
+
+
+def genghis() -> Trial:
+    return trial(SEED, 220.0, *GENGHIS)
+
+
+def alternate(pushes: list[Push]) -> bool:
+    """Between any two consecutive completed pushes of one end, the other end was pushed (completed in between,
+    inclusive: the two robots' first pushes finish in the same tick)."""
+    for end in (LEFT, RIGHT):
+        times = [p.completed for p in pushes if p.end == end]
+        others = [p.completed for p in pushes if p.end != end]
+        if any(not any(a <= t <= b for t in others) for a, b in pairwise(times)):
+            return False
+    return True
+
+
+# -- two R-2s ---------------------------------------------------------------------------------------------------
+def test_two_r2s_push_their_own_ends_in_turn_and_the_box_advances_square():
+    t = no_faults()
+    red, green = t.of("red"), t.of("green")
+    assert {p.end for p in red} == {LEFT} and {p.end for p in green} == {RIGHT}  # never the other's end
+    # 60 s at about one push each per 9 s (measured 8 and 7): a robot that stopped after a few would fail.
+    assert len(red) >= 5 and len(green) >= 5
+    assert alternate(t.pushes), t.pushes
+    # Once in step (after the start, when both ends are applicable to both), a push starts only after the
+    # other end's push is complete: one at a time.
+    settled = [p for p in t.pushes if p.activated >= 10.0]
+    assert all(b.activated >= a.completed for a, b in pairwise(settled)), settled
+    assert len(settled) >= 8 and all(a.end != b.end for a, b in pairwise(settled)), settled
+    # The box advances (measured 0.53 m in 60 s) and stays square (measured -2.0 degrees).
+    assert t.metrics["advance_m"] > 0.1
+    assert abs(t.metrics["heading_drift_deg"]) < 5.0
+    assert t.metrics["pushes"] == len(red) + len(green)
+
+
+# -- an R-2 taken away and put back (§6.1.2) ---------------------------------------------------------------------
+@pytest.mark.parametrize("seed", [SEED, 2])
+def test_the_survivor_takes_the_other_end_over_after_a_brief_pause(seed):
+    """green is removed at 30 s. red's push-right becomes applicable when its own last left push completes, and
+    it activates when its motivation reaches theta: at the slow rate 1/phi (phi = r2_patience = 7 s) while green
+    still counts as doing push-right, reset to zero when green is first heard about it (up to one 3 s radio
+    period later), and at the fast rate once green's claim lapses, tau = 9 s after its last message (sent in
+    the 3 s before 30 s). So the pause is at most 3 + 7 s and a tick. At these seeds red's last left push
+    completes by 32 s, and green's claim lasts to at least 27 + 9 = 36 s (or, if green is heard after the push,
+    phi from then), so the pause is at least 4 s. Measured: 6.0 s at seed 1 (the claim lapsed first: red's push
+    completed at 32.0 s, after the removal) and 10.0 s at seed 2 (green alive when red's push completed at
+    26.4 s: reset, then phi). The thesis: 'about 5 to 8 seconds'."""
+    t = takeover() if seed == SEED else trial(seed, 64.0, "remove:green@30")
+    last_left = max(p.completed for p in t.of("red", until=30.0) if p.end == LEFT)
+    first_right = min(p.activated for p in t.of("red") if p.end == RIGHT)
+    pause = first_right - last_left
+    assert 4.0 <= pause <= 3.0 + PARAMS.r2_patience + 1.0, (last_left, first_right)
+    if seed == SEED:
+        assert pause == pytest.approx(6.0, abs=1.0)  # as measured; the bound above is the mechanism's
+    assert not t.of("green", since=30.0, until=90.0)
+
+
+def test_the_survivor_pushes_both_ends_while_alone():
+    t = takeover()
+    alone = t.of("red", since=30.0, until=90.0)  # green is away from 30 s to 90 s
+    assert {p.end for p in alone} == {LEFT, RIGHT}, alone  # measured: right, left, right
+    assert all(a.end != b.end for a, b in pairwise(alone))  # each push at the other end from the last
+    # Acquiring the other end (back off, along the box, round its end) is slow, but each push is complete.
+    assert all(p.completed - p.activated >= PARAMS.push_time for p in alone)
+
+
+def test_a_revived_r2_comes_back_at_the_free_end_and_the_two_share_the_ends_again():
+    """green is put back at 90 s behind the end with no robot near it (red has gone to the right end), with a
+    fresh controller; after 40 s to settle, each robot pushes only its own end, in turn."""
+    t = takeover()
+    back = t.of("green", since=90.0)
+    assert back, "green never pushed after its revival"
+    assert back[0].completed < 90.0 + 20.0  # it joins in promptly (measured 101.4 s)
+    end = t.world.scene.info["ends"]["green"]  # where entry_pose set it down
+    assert all(p.end == end for p in back)
+    late = [p for p in t.pushes if p.activated >= 130.0]
+    red, green = [p for p in late if p.robot == "red"], [p for p in late if p.robot == "green"]
+    assert len(red) >= 3 and len(green) >= 3  # measured 8 and 6 in 130-200 s
+    assert {p.end for p in green} == {end} and {p.end for p in red} == {LEFT if end == RIGHT else RIGHT}
+    assert alternate(late)
+    assert t.world.robots["green"].active and t.world.robots["red"].active
+
+
+# -- Genghis-II in green's place ---------------------------------------------------------------------------------
+def test_genghis_pushes_its_end_and_the_r2_pushes_less_often():
+    """Green is removed and Genghis-II added at 40 s (set down at the free, right, end). Each of its pushes walks
+    into the box for genghis_push_time (10 s) and backs off; red's push-left is applicable only after news of a
+    newer right push, so red waits for Genghis-II's slow pushes: its interval between left pushes grows from
+    about 9 s (measured 9.0 s with green, after the start) to about 12 s (measured 12.4 s)."""
+    t = genghis()
+    g = t.of("genghis")
+    assert len(g) >= 5 and {p.end for p in g} == {RIGHT}  # measured 10
+    assert all(p.completed - p.activated >= PARAMS.genghis_push_time + PARAMS.release_time - 1e-6 for p in g)
+    assert t.world.scene.info["ends"]["genghis"] == RIGHT
+    before = [p.activated for p in t.of("red", since=10.0, until=40.0) if p.end == LEFT]
+    after = [p.activated for p in t.of("red", since=45.0, until=160.0) if p.end == LEFT]
+    assert len(before) >= 3 and len(after) >= 5
+    mean_before = (before[-1] - before[0]) / (len(before) - 1)
+    mean_after = (after[-1] - after[0]) / (len(after) - 1)
+    assert mean_after > mean_before + 2.0, (before, after)
+    assert mean_after >= PARAMS.genghis_push_time
+    assert not t.of("red", since=160.0)  # removed
+
+
+def test_genghis_goes_home_once_the_r2_is_gone():
+    """red is removed at 160 s: Genghis-II no longer hears anyone pushing the left end, finishes its push, and
+    go-home (applicable while nobody is heard pushing the opposite end) walks it back from the box."""
+    t = genghis()
+    changes = t.behaviour_changes("genghis")
+    went_home = [time for time, to in changes if to == GO_HOME]
+    assert went_home and went_home[0] > 160.0  # never before red was removed (measured 169.5 s)
+    assert went_home[0] < 160.0 + 30.0
+    robot = t.world.robots["genghis"]
+    assert robot.behaviour == GO_HOME and t.metrics["final_behaviour"]["genghis"] == GO_HOME
+    assert robot.behaviour_time[GO_HOME] > 20.0  # measured 50.6 s: from about 170 s to the end
+    # It walked home_distance back from where it stood to push (measured 1.62 m behind the box's centre at the
+    # end, against 0.32 m while pushing).
+    x, y, yaw = MISSION.box_pose(t.world)
+    gx, gy = t.world.pose(robot)[:2]
+    behind = -((gx - x) * math.cos(yaw) + (gy - y) * math.sin(yaw))
+    dims = t.world.scene.scenario.objects.box
+    assert behind > dims.depth / 2 + STAND_BACK["genghis2"] + 0.5 * PARAMS.home_distance
+
+
+# -- the faults ---------------------------------------------------------------------------------------------------
+def test_remove_and_revive_parse_and_change_health():
+    remove, revive = parse_fault("remove:red@60"), parse_fault("revive:red@120")
+    assert (remove.kind, remove.robot, remove.time, remove.options) == ("remove", "red", 60.0, {})
+    assert (revive.kind, revive.robot, revive.time, revive.options) == ("revive", "red", 120.0, {})
+    health = Health()
+    apply_fault(remove, health, ("left", "right"))
+    assert not health.alive and not health.radio_on and health.removed
+    apply_fault(revive, health, ("left", "right"))
+    assert health.alive and health.radio_on  # (the world puts it back and clears `removed`)
+    with pytest.raises(ConfigError, match="unknown option 'kind' for remove"):
+        parse_fault("remove:red@60,kind=r2")
+
+
+# -- bad input, through the CLI -------------------------------------------------------------------------------------
+def run_cli(capsys, *argv: str) -> tuple[int, str, str]:
+    from teamsim.cli import main
+
+    code = main(list(argv))
+    captured = capsys.readouterr()
+    return code, captured.out, captured.err
+
+
+def assert_one_line_error(code: int, err: str, fragment: str) -> None:
+    assert code == 2, err
+    assert err.startswith("teamsim: error: ") and err.count("\n") == 1, err
+    assert fragment in err, err
+
+
+@pytest.mark.parametrize("argv, fragment", [
+    (["--fault", "remove:purple@5"], "no robot 'purple'; team: red, green"),
+    (["--fault", "revive:purple@5"], "no robot 'purple'; team: red, green"),
+    (["--set", "advance=50"], "task.advance=50: the box would leave the 7.9248 x 3.6576 m room"),
+    (["--set", "right=spider"], "right='spider': allowed values are r2, genghis2"),
+])
+def test_bad_input_is_one_line_and_exit_2(capsys, tmp_path, argv, fragment):
+    code, _, err = run_cli(capsys, "run", "box-pushing", *argv, "--out", str(tmp_path))
+    assert_one_line_error(code, err, fragment)
+    assert not list(tmp_path.iterdir()), "nothing is written for a rejected run"
+
+
+def genghis_scenario(capsys, tmp_path, acquires):
+    """The mission's own scenario with Genghis-II at the right end (`teamsim scenario show --set right=genghis2`),
+    its controller's `acquires` set as given, written to a file."""
+    shown = tmp_path / "shown.yaml"
+    code, _, err = run_cli(capsys, "scenario", "show", "box-pushing", "--set", "right=genghis2",
+                           "--output", str(shown))
+    assert code == 0, err
+    scenario = yaml.safe_load(shown.read_text())
+    assert scenario["robots"]["genghis"]["kind"] == "genghis2"
+    scenario["robots"]["genghis"]["controller"]["acquires"] = acquires
+    path = tmp_path / f"acquires-{acquires}.yaml"
+    path.write_text(yaml.safe_dump(scenario))
+    return path
+
+
+def test_a_genghis_asked_to_acquire_an_end_is_rejected(capsys, tmp_path):
+    path = genghis_scenario(capsys, tmp_path, True)
+    out = tmp_path / "out"
+    code, _, err = run_cli(capsys, "run", "box-pushing", "--scenario", str(path), "--out", str(out),
+                           "--duration", "1")
+    assert_one_line_error(code, err, "robots.genghis.controller.acquires=true: Genghis-II cannot acquire")
+    assert not out.exists() or not list(out.iterdir())
+
+
+def test_a_genghis_that_does_not_acquire_runs(capsys, tmp_path):
+    """The same file with acquires: false is accepted (1 s: not enough to complete, so status 1, not 2)."""
+    path = genghis_scenario(capsys, tmp_path, False)
+    code, out, err = run_cli(capsys, "run", "box-pushing", "--scenario", str(path), "--out", str(tmp_path / "out"),
+                             "--duration", "1")
+    assert code == 1 and out.startswith("failed: "), err
+
+
+@pytest.mark.xfail(strict=True, reason="room_ahead measures from |x| of the box, not along its direction of "
+                                       "travel: it says 'up to about 1.00 m' for a box with 6.6 m ahead")
+def test_the_rejection_says_how_far_the_box_can_go():
+    config = resolve(TrialConfig(mission="box-pushing", params=MISSION.Params(), seed=SEED), MISSION)
+    scenario = config.scenario
+    MISSION.check_scenario(scenario)  # the default 5 m is accepted ...
+    assert MISSION.room_ahead(scenario) >= scenario.task.advance  # ... so the hint must allow at least that
