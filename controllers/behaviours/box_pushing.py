@@ -270,6 +270,10 @@ class PushEnd:
     def _done(self, obs: Observation) -> Command:
         return self.drive()
 
+    @property
+    def finished(self) -> bool:
+        return self.state == "done"
+
     def drive(self, v: float = 0.0, omega: float = 0.0) -> Command:
         return Command(v=v, omega=omega, behaviour=self.name)
 
@@ -288,14 +292,20 @@ class R2BoxPusher:
         self.sets = {}
         for e in (end, OPPOSITE[end]) if acquires else (end,):
             self.sets[push_task(e)] = PushEnd(robot, e, self.knowledge, self.station, self.estimate, params)
-        definitions = [BehaviourSetDefinition(name, lambda obs, e=s.end: self.knowledge.applicable(e), s,
-                                              rates=rates) for name, s in self.sets.items()]
+        # A finished push takes its set's feedback down for a tick, so that the set ends and starts afresh even when
+        # news of the other end's push arrives at once (at equal push times both robots' own ends are applicable
+        # again at once, and a set that stayed active sat in its finished state for good: seed 206).
+        definitions = [BehaviourSetDefinition(name, lambda obs, s=s: self.applicable(s), s, rates=rates)
+                       for name, s in self.sets.items()]
         self.alliance = AllianceController(robot.name, definitions, alliance)
         self.active = IDLE
 
     @property
     def pushes(self) -> list:
         return self.knowledge.pushes
+
+    def applicable(self, push: PushEnd) -> bool:
+        return self.knowledge.applicable(push.end) and not push.finished
 
     def __call__(self, obs: Observation) -> Command:
         for message in obs.inbox:
