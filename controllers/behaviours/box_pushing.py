@@ -36,6 +36,7 @@ from teamsim.controllers.skills.goto import DriveParams, steer_to, turn_to
 from teamsim.controllers.skills.pose_estimate import PoseEstimate
 from teamsim.models.r2 import TIP_IR
 from teamsim.models.robot import RobotModel
+from teamsim.positioning import wrap_angle
 
 LEFT, RIGHT = "left", "right"
 ENDS = (LEFT, RIGHT)
@@ -145,13 +146,8 @@ class PushKnowledge:
 @dataclass
 class Station:
     """Where an R-2 stands: the end it is at, and the heading that pushes into the box there."""
-    end: str
-    heading: float | None = None  # taken from the pose at the first push (the R-2 starts facing its end)
-
-
-def tip_ranges(obs: Observation, tips: list[int], cap: float) -> tuple[float, float]:
-    left, right = np.minimum(obs.ir_range[tips], cap)
-    return float(left), float(right)
+    end: str | None  # None: between the ends
+    heading: float | None = None  # from the compass at the end of each push (the R-2 starts facing its end)
 
 
 class PushEnd:
@@ -163,7 +159,6 @@ class PushEnd:
         self.estimate, self.params = estimate, params
         self.tips = [robot.ir_sensors.index(n) for n in TIP_IR]
         self.side_ir = {e: robot.ir_sensors.index(SIDE_IR[e]) for e in ENDS}
-        self.ir_range = robot.ir.max_range
         self.name = push_task(end)
         self.restart()
 
@@ -175,7 +170,7 @@ class PushEnd:
         if self.since is None:
             self.since = obs.time
         if self.station.heading is None:
-            self.station.heading = float(self.estimate.pose[2])
+            self.station.heading = float(obs.pose.heading)
         return getattr(self, f"_{self.state}")(obs)
 
     def _go(self, state: str, obs: Observation) -> Command:
@@ -186,7 +181,10 @@ class PushEnd:
         return float(np.hypot(*(self.estimate.pose[:2] - self.mark[1][:2])))
 
     def _start(self, obs: Observation) -> Command:
-        return self._go("approach" if self.station.end == self.end else "back_off", obs)
+        if self.station.end == self.end:
+            return self._go("approach", obs)
+        self.station.end = None  # leaving its end: between the ends until it has turned into the other
+        return self._go("back_off", obs)
 
     # -- acquiring the end -----------------------------------------------------------------------------------
     def _back_off(self, obs: Observation) -> Command:
@@ -241,13 +239,19 @@ class PushEnd:
 
     # -- pushing ---------------------------------------------------------------------------------------------
     def square(self, obs: Observation) -> float:
-        """Turn rate that squares the jaw up to the face: towards the nearer fingertip reading."""
-        left, right = tip_ranges(obs, self.tips, self.ir_range)
-        return float(np.clip(self.params.square_gain * (right - left), -0.3, 0.3))
+        """Turn rate that squares the jaw up to the face (towards the nearer fingertip reading) while both
+        fingertips see it; else one that holds the push heading by the compass. (Squaring on one fingertip turned
+        a robot at the corner 30 degrees off the box; the wheels slip while pushing, so the encoders' heading
+        does too.)"""
+        left, right = obs.ir_range[self.tips]
+        if math.isfinite(left) and math.isfinite(right):
+            return float(np.clip(self.params.square_gain * (right - left), -0.3, 0.3))
+        error = wrap_angle(self.station.heading - obs.pose.heading)
+        return float(np.clip(self.params.drive.turn_gain * error, -0.3, 0.3))
 
     def _approach(self, obs: Observation) -> Command:
         p = self.params
-        contact = min(tip_ranges(obs, self.tips, self.ir_range)) < p.contact_range
+        contact = min(obs.ir_range[self.tips]) < p.contact_range
         if contact or obs.touch.get("bump_front", 0.0) >= p.drive.bump_force or \
                 obs.time - self.mark[0] >= p.approach_timeout:
             return self._go("push", obs)
@@ -256,7 +260,7 @@ class PushEnd:
     def _push(self, obs: Observation) -> Command:
         p = self.params
         if obs.time - self.mark[0] >= p.push_time:
-            self.station.heading = float(self.estimate.pose[2])
+            self.station.heading = float(obs.pose.heading)  # the compass: the encoders slipped while pushing
             return self._go("release", obs)
         return self.drive(p.push_speed, self.square(obs))
 
@@ -317,11 +321,12 @@ class R2BoxPusher:
             if self.active in self.sets:
                 self.sets[self.active].restart()
             self.active = command.behaviour
-        return announce(command, push_task(self.station.end), self.knowledge)
+        return announce(command, push_task(self.station.end) if self.station.end else None, self.knowledge)
 
 
-def announce(command: Command, standing_task: str, knowledge: PushKnowledge) -> Command:
-    """The broadcast: the active set's task, or between pushes the end the robot stands at; and the push news."""
+def announce(command: Command, standing_task: str | None, knowledge: PushKnowledge) -> Command:
+    """The broadcast: the active set's task, or between pushes the end the robot stands at (None: at neither, idle);
+    and the push news."""
     task = announced_task(command.broadcast) if command.behaviour != IDLE else standing_task
     return replace(command, broadcast=activity_message(task, knowledge.message()))
 

@@ -5,7 +5,7 @@ Parker's 26 x 12 ft room near the west wall, its length across the room. An R-2 
 another R-2 ("green") or Genghis-II ("genghis") its right end (left and right as seen from behind the box,
 looking east). They push the ends in turn under ALLIANCE (:mod:`teamsim.controllers.behaviours.box_pushing`),
 and the box crosses the room through the contact forces of their pushes. The mission completes when the box's
-centre has advanced ``advance`` m along its starting normal (5 m by default: from 1 m off the west wall to 1.7 m
+centre has advanced ``advance`` m along its starting normal (5 m by default: from 1 m off the west wall to 1.6 m
 short of the east one; the thesis says only "across a room").
 
 Parker's experiments are faults: ``remove:green@T`` takes an R-2 away (§6.1.2 "seized and switched off"),
@@ -133,7 +133,7 @@ class BoxPushingMission(ScenarioMission):
     def room_ahead(scenario: Scenario) -> float:
         """How far the box can advance along its normal before its front face meets a wall, m."""
         box, dims = scenario.objects.boxes[0], scenario.objects.box
-        limits = [(half - dims.depth / 2 - abs(c)) / abs(d) if d else math.inf
+        limits = [(math.copysign(half - dims.depth / 2, d) - c) / d if abs(d) > 1e-9 else math.inf
                   for c, d, half in ((box.x, math.cos(box.yaw), scenario.arena.size[0] / 2),
                                      (box.y, math.sin(box.yaw), scenario.arena.size[1] / 2))]
         return max(0.0, min(limits))
@@ -183,8 +183,8 @@ class BoxPushingMission(ScenarioMission):
             pose = behind_end(box, dims, end, robot.model.kind)
             if all(math.dist(pose[:2], p) >= CLEAR for p in others):
                 break
-        else:  # both ends taken: wait behind the middle, further back
-            pose = behind_end(box, dims, own, robot.model.kind)
+        else:  # both ends taken: wait 0.8 m further back behind its own end
+            end, pose = own, behind_end(box, dims, own, robot.model.kind)
             pose = (pose[0] - 0.8 * math.cos(box[2]), pose[1] - 0.8 * math.sin(box[2]), box[2])
         world.scene.info["ends"][name] = end
         return pose
