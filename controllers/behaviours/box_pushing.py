@@ -405,6 +405,7 @@ class GenghisBoxPusher:
                                    rates=params.rates(params.go_home_delay, params.r2_patience, {}))]
         self.alliance = AllianceController(robot.name, definitions, alliance)
         self.active = IDLE
+        self.went_home_at: float | None = None  # when go-home last became active
 
     @property
     def pushes(self) -> list:
@@ -426,6 +427,8 @@ class GenghisBoxPusher:
             if self.active in self.sets:
                 self.sets[self.active].restart()
             self.active = command.behaviour
+            if self.active == GO_HOME:
+                self.went_home_at = obs.time
         standing = GO_HOME if self.active == GO_HOME else push_task(self.end)
         return announce(command, standing, self.knowledge)
 

@@ -209,5 +209,7 @@ class BoxPushingMission(ScenarioMission):
             "pushes_per_robot": per_robot,
             "push_log": [[p.robot, p.end, round(p.activated, 2), round(p.completed, 2)] for p in pushes],
             "final_behaviour": {n: r.behaviour if r.active else "off" for n, r in world.robots.items()},
+            "went_home_at": {n: r.controller.went_home_at for n, r in world.robots.items()
+                             if getattr(r.controller, "went_home_at", None) is not None},
         }
         return advance >= world.scene.scenario.task.advance, metrics

@@ -38,7 +38,8 @@ RADIO_PERIOD = 3.0  # s: one broadcast per robot every 3 s (§2.2.3); the spread
 COLUMNS = ("experiment", "trial", "seed", "status", "change_at", "second_change_at", "advance_m", "heading_drift_deg",
            "pause_own_s", "pause_dead_s", "takeover_at", "survivor_ends", "returned_pushes", "pair_split",
            "red_rate_before", "red_rate_after", "helper_rate", "genghis_rate", "final_genghis", "go_home_delay_s",
-           *(f"{end}_per_min_{k}" for k in (1, 2, 3) for end in ("left", "right")), "real_time_factor")
+           "early_home_s", *(f"{end}_per_min_{k}" for k in (1, 2, 3) for end in ("left", "right")),
+           "real_time_factor")
 PHASES = {"robot-failure": ("before the removal", "while green is away", "after the return"),
           "heterogeneity": ("red and green", "red and Genghis-II", "Genghis-II alone")}
 
@@ -124,12 +125,16 @@ def result_row(study: BoxPushingStudy, config: TrialConfig, summary: dict) -> di
     else:
         last = at + study.with_genghis
         final = (metrics.get("final_behaviour") or {}).get("genghis")
-        home = (summary.get("robots") or {}).get("genghis", {}).get("task_time_s", {}).get("go-home", 0.0)
+        home_at = (metrics.get("went_home_at") or {}).get("genghis")
+        home_s = (summary.get("robots") or {}).get("genghis", {}).get("task_time_s", {}).get("go-home", 0.0)
         row.update(second_change_at=last, red_rate_before=rate(pushes, "red", 0.0, at, "left"),
                    red_rate_after=rate(pushes, "red", at + study.settle, last, "left"),
                    helper_rate=rate(pushes, "green", 0.0, at), genghis_rate=rate(pushes, "genghis", at + study.settle,
                                                                                   last),
-                   final_genghis=final, go_home_delay_s=round(end - home - last, 1) if final == "go-home" else None)
+                   final_genghis=final,
+                   go_home_delay_s=round(home_at - last, 1) if final == "go-home" and home_at is not None else None,
+                   # go-home time before the last R-2 went: Genghis-II heard nobody at the opposite end for tau
+                   early_home_s=round(home_s - (end - home_at if final == "go-home" else 0.0), 1))
     return row
 
 
@@ -214,6 +219,7 @@ def _heterogeneity(study: BoxPushingStudy, rows: list[dict]) -> list[str]:
     _, p = paired_t_test(after, before)
     fewer = sum(a < b for a, b in zip(after, before))
     home = sum(r["final_genghis"] == "go-home" for r in rows)
+    early = [r for r in rows if (r.get("early_home_s") or 0.0) > 0.0]
     drop = _mean(rows, "red_rate_after") / _mean(rows, "red_rate_before")
     lines = ["## Experiment 2: heterogeneity", "",
              f"green replaced by Genghis-II at a random time in {study.remove_window[0]:g}-"
@@ -226,7 +232,15 @@ def _heterogeneity(study: BoxPushingStudy, rows: list[dict]) -> list[str]:
              f"{_mean(rows, 'helper_rate'):.1f} / {_mean(rows, 'genghis_rate'):.1f} | "
              f"{'yes' if _mean(rows, 'genghis_rate') < _mean(rows, 'helper_rate') else 'no'} |",
              f"| Genghis-II goes home once the last R-2 is gone | yes | {home}/{n}; delay after red's removal: "
-             f"{_summary(r['go_home_delay_s'] for r in rows)} s | {'yes' if home == n else 'partly'} |", ""]
+             f"{_summary(r['go_home_delay_s'] for r in rows)} s | {'yes' if home == n else 'partly'} |",
+             f"| ... and not before | yes | went home while red was there in {len(early)}/{n}"
+             + (": " + ", ".join(f"trial {r['trial']} ({r['early_home_s']:g} s)" for r in early) if early else "")
+             + f" | {'yes' if not early else 'partly'} |", ""]
+    if early:
+        lines += ["Genghis-II joins as green leaves, and red takes green's end over after its pause unless it has "
+                  "heard Genghis-II announce that end first (one radio slot, up to 3 s): then red pushes the right "
+                  "end, nobody announces the left one, and Genghis-II, hearing nobody at the opposite end for tau, "
+                  "goes home until red is back at the left end.", ""]
     return lines
 
 
