@@ -401,11 +401,12 @@ class GenghisBoxPusher:
         definitions = [
             BehaviourSetDefinition(self.push.name, lambda obs: self.opposite_pushed(obs) and not self.push.done,
                                    self.push, rates=rates),
-            BehaviourSetDefinition(GO_HOME, lambda obs: not self.opposite_pushed(obs), self.home,
+            BehaviourSetDefinition(GO_HOME, lambda obs: self.nobody_pushes(obs), self.home,
                                    rates=params.rates(params.go_home_delay, params.r2_patience, {}))]
         self.alliance = AllianceController(robot.name, definitions, alliance)
         self.active = IDLE
         self.went_home_at: float | None = None  # when go-home last became active
+        self.on_since: float | None = None  # when it first sensed (switched on)
 
     @property
     def pushes(self) -> list:
@@ -414,6 +415,13 @@ class GenghisBoxPusher:
     def opposite_pushed(self, obs: Observation) -> bool:
         task = push_task(OPPOSITE[self.end])
         return any(t == task and obs.time - when < self.tau for t, when in self.heard.values())
+
+    def nobody_pushes(self, obs: Observation) -> bool:
+        """Nobody heard at the opposite end within tau, having listened for tau (switched on, it has heard
+        nobody yet: it went home for a moment before its teammate's first message, seeds 404-419)."""
+        if self.on_since is None:
+            self.on_since = obs.time
+        return obs.time - self.on_since >= self.tau and not self.opposite_pushed(obs)
 
     def __call__(self, obs: Observation) -> Command:
         for message in obs.inbox:
