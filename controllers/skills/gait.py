@@ -51,19 +51,20 @@ class TripodGait:
     def targets(self, time: float) -> np.ndarray:
         """(swing, lift) set-points of each leg in turn, rad, in the order of ``spec.actuators``."""
         spec = self.spec
-        if np.all(np.abs(self.stride) < STANDING_STRIDE):
-            swing = np.zeros(len(spec.legs))
-            lift = np.full(len(spec.legs), spec.lift_stance)
-        else:
-            phase = self.phases(time)
-            stance = phase < 0.5
-            swing_phase = 2 * np.pi * (phase - 0.5)  # 0 .. pi over the swing
-            # Foot position along the stroke: +1 at the front, -1 at the back.
-            stroke = np.where(stance, 1.0 - 4.0 * phase, -np.cos(swing_phase))
-            swing = np.arcsin(stroke * self.stride / (2 * spec.reach))
-            raise_by = np.where(stance, 0.0, np.sin(swing_phase))
-            lift = spec.lift_stance + (spec.lift_swing - spec.lift_stance) * raise_by
-        return np.column_stack([swing, lift]).ravel()
+        out = np.empty(2 * len(spec.legs))
+        if float(np.abs(self.stride).max()) < STANDING_STRIDE:
+            out[0::2] = 0.0
+            out[1::2] = spec.lift_stance
+            return out
+        phase = self.phases(time)
+        stance = phase < 0.5
+        swing_phase = 2 * np.pi * (phase - 0.5)  # 0 .. pi over the swing
+        # Foot position along the stroke: +1 at the front, -1 at the back.
+        stroke = np.where(stance, 1.0 - 4.0 * phase, -np.cos(swing_phase))
+        out[0::2] = np.arcsin(stroke * self.stride / (2 * spec.reach))
+        raise_by = np.where(stance, 0.0, np.sin(swing_phase))
+        out[1::2] = spec.lift_stance + (spec.lift_swing - spec.lift_stance) * raise_by
+        return out
 
     def stop(self) -> None:
         """Immediate stop (a killed robot): every leg back to neutral with its foot down."""
