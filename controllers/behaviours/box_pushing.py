@@ -61,13 +61,16 @@ class BoxPushParams:
     # .3 Hz communication messages actually get transmitted' (§6.1.2): the radio sets the delay, not theta/delta.
     fast_delay: float = setting(0.3, lo=0.01, meaning="theta / delta_fast, s: how soon an applicable push starts "
                                                       "when nobody else does it")
-    # delta_slow_R(R-2) = theta / phi sets the pause before a survivor takes the other end over (§6.1.2: 'about
-    # 5 to 8 seconds'). It must outlast a live teammate's whole turn, up to 9 s from this robot's own push (two
-    # radio waits of up to 3 s, fast_delay, an approach, push_time, release_time): with 7 s a healthy robot was
-    # taken over (docs/decisions.md).
-    r2_patience: float = setting(10.0, lo=0.1, meaning="phi for an R-2 teammate, s: theta / delta_slow_R(R-2)")
-    # delta_slow_R(Genghis-II) < delta_slow_R(R-2) (§6.1.2): a Genghis-II push lasts genghis_push_time.
-    genghis_patience: float = setting(40.0, lo=0.1, meaning="phi for a Genghis-II teammate, s: theta / "
+    # delta_slow_R(R-2) = theta / phi. phi must outlast whatever a live teammate takes over an end it has
+    # announced: its whole push turn from its first message after this robot's push (two radio waits of up to 3 s,
+    # fast_delay, an approach, push_time, release_time: about 9 s; with phi 7 s a healthy robot was taken over),
+    # and an acquisition of the other end (about 20 s; with phi 10 s a revived robot took the end its teammate was
+    # acquiring, and the two chased the ends, seed 505). A removed teammate stops announcing, and its claim lapses
+    # tau after its last message: that, not phi, sets the pause before a survivor takes its end over (§6.1.2:
+    # 'about 5 to 8 seconds'; docs/decisions.md).
+    r2_patience: float = setting(30.0, lo=0.1, meaning="phi for an R-2 teammate, s: theta / delta_slow_R(R-2)")
+    # delta_slow_R(Genghis-II) < delta_slow_R(R-2) (§6.1.2): a Genghis-II push lasts genghis_push_time and more.
+    genghis_patience: float = setting(60.0, lo=0.1, meaning="phi for a Genghis-II teammate, s: theta / "
                                                             "delta_slow_R(Genghis-II)")
     acquiesce_after: float = setting(30.0, lo=0.1, meaning="psi, s active before yielding a push to a teammate "
                                                            "heard doing it")
