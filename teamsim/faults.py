@@ -5,8 +5,8 @@ CLI form: ``KIND:ROBOT@SECONDS[,key=value...]``, e.g. ``kill:red@60``, ``blind-i
 ``break-motor:red@5,motor=left``, ``add-robot:purple@20,kind=diffdrive``, ``remove:red@60`` (taken out of the
 arena, as Parker seized an R-2, §6.1.2), ``revive:red@120`` (switched on again with a fresh controller; a removed
 robot is put back where the mission says, else at its start). The world applies each fault at its time and
-records an event; a fault only changes a robot's :class:`Health`, which the world consults when sensing and
-actuating.
+records an event; a fault changes a robot's :class:`Health`, which the world consults when sensing and actuating
+(and the world moves a removed or revived robot and gives a revived one a fresh controller).
 """
 from __future__ import annotations
 
@@ -52,6 +52,7 @@ class Health:
     alive: bool = True
     ir_blind: tuple = ()  # name prefixes of the blinded IR sensors ("" blinds them all)
     radio_on: bool = True
+    radio_cut: bool = False  # a radio-off fault: the radio stays off through a power cycle (revive)
     gripper_broken: bool = False
     speed_factor: float = 1.0
     broken_motors: set = field(default_factory=set)
@@ -97,13 +98,14 @@ def apply_fault(fault: Fault, health: Health, motor_names: tuple[str, ...]) -> N
         health.radio_on = False
         health.removed = health.removed or kind == "remove"
     elif kind == "revive":
-        health.alive = health.radio_on = True
+        health.alive = True
+        health.radio_on = not health.radio_cut
     elif kind == "blind-ir":
         health.ir_blind += tuple(fault.options.get("sensors", "").split("+"))
     elif kind == "radio-off":
-        health.radio_on = False
+        health.radio_on, health.radio_cut = False, True
     elif kind == "radio-on":
-        health.radio_on = health.alive
+        health.radio_on, health.radio_cut = health.alive, False
     elif kind == "break-motor":
         health.broken_motors.add(fault.options.get("motor") or motor_names[0])
     elif kind == "slow":

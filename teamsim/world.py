@@ -158,11 +158,15 @@ class World:
     # -- set-up ---------------------------------------------------------------------------------------------
     def check_faults(self, faults: list[Fault]) -> None:
         """Reject faults naming unknown robots or parts they lack, before anything runs."""
+        joins = {f.robot: f.time for f in faults if f.kind == "add-robot"}
         for fault in faults:
             robot = self.robots.get(fault.robot)
             spec = f"--fault {fault.kind}:{fault.robot}@{fault.time:g}"
             if fault.kind == "add-robot":
                 continue  # checked as the team is built
+            if fault.robot in joins and fault.time < joins[fault.robot]:
+                raise ConfigError(f"{spec}: {fault.robot} joins at {joins[fault.robot]:g} s (add-robot); its faults "
+                                  f"must come at or after that")
             if robot is None:
                 raise ConfigError(f"{spec}: no robot {fault.robot!r}; team: {', '.join(self.robots)}")
             if fault.kind == "break-motor" and fault.options.get("motor") not in (None, *robot.model.motors):
@@ -424,8 +428,9 @@ class World:
     def _place(self, robot: Robot) -> None:
         """Bring a dormant robot into the arena (the add-robot fault): where the mission's ``entry_pose(world,
         name)`` says, with a controller made for that place, or else at its reserved spawn pose."""
-        if hasattr(self.mission, "entry_pose"):
-            self._move(robot, self.mission.entry_pose(self, robot.name))
+        where = getattr(self.mission, "entry_pose", None)
+        if where is not None:
+            self._move(robot, where(self, robot.name))
             self._restart_controller(robot)
         else:
             self._move(robot, robot.spawn)
@@ -441,7 +446,9 @@ class World:
         self._restart_controller(robot)
 
     def _restart_controller(self, robot: Robot) -> None:
+        """A fresh controller, as after a power cycle; its radio forgets what it was about to say."""
         self._restarts += 1
+        self.radio.set_outbox(robot.name, {})
         stream = self.streams.get("robot", robot.name, "brain", "restart", str(self._restarts))
         robot.controller = self.mission.controller(robot.model, self.scene, stream)
         robot.drive = make_locomotion(robot.model.drive, robot.model.limits, self.control_dt)

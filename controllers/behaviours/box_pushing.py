@@ -10,7 +10,8 @@ are applicable ("every robot thinks the opposite end was just pushed").
 - R-2 (:class:`R2BoxPusher`, Fig. 6-1): push-left and push-right (:class:`PushEnd`), symmetric. An activation
   acquires the end if the robot is not already there (back off, turn along the box, follow it with the side IR
   to its end, back up, turn into the box), closes in with the fingertip IR, pushes for ``push_time`` keeping
-  square to the face with the fingertip IR, backs off a little, and records the push complete. Its own end's
+  square to the face with the fingertip IR (holding its heading by the compass while only one fingertip sees the
+  face), backs off a little, and records the push complete. Its own end's
   set comes first in its priority order (the tie-break of §3.6: both sets cross theta together at the start).
 - Genghis-II (:class:`GenghisBoxPusher`, Fig. 6-2): *push* (applicable while a teammate is heard pushing the
   opposite end) walks into its end, keeping square with its whiskers, for ``genghis_push_time``; *go-home*
@@ -87,6 +88,7 @@ class BoxPushParams:
     approach_timeout: float = 4.0  # s closing in before pushing anyway
     square_gain: float = 2.0  # rad/s per m of difference between the two fingertip readings
     whisker_gain: float = 0.02  # rad/s per N of difference between the two whiskers' contact forces
+    whisker_timeout: float = 8.0  # s Genghis-II walks towards the box before its push time runs without a touch
     genghis_push_delay: float = 1.0  # s: theta / delta_fast_GP, Genghis-II's push (§6.1.1 gives no value)
     go_home_delay: float = 2.0  # s: theta / delta_fast_GH
     release_time: float = 0.3  # s backing off after a push, so the box can turn freely under the other end
@@ -352,7 +354,7 @@ class GenghisPush:
         if self.since is None:
             self.since = obs.time
         left, right = (obs.touch.get(w, 0.0) for w in WHISKERS)
-        if self.touched is None and (left > 0.0 or right > 0.0 or obs.time - self.since >= 2 * p.approach_timeout):
+        if self.touched is None and (left > 0.0 or right > 0.0 or obs.time - self.since >= p.whisker_timeout):
             self.touched = obs.time
         if self.touched is not None and obs.time - self.touched >= p.genghis_push_time:
             if obs.time - self.touched < p.genghis_push_time + p.release_time:
@@ -400,7 +402,7 @@ class GenghisBoxPusher:
         self.push = GenghisPush(robot, end, self.knowledge, params)
         self.home = GoHome(params, robot.limits.v_max, robot.limits.omega_max)
         self.sets = {self.push.name: self.push, GO_HOME: self.home}
-        rates = params.rates(params.genghis_push_delay, params.r2_patience, {})
+        rates = params.rates(params.genghis_push_delay, params.r2_patience, {})  # (phi: an R-2 pushing its end)
         definitions = [
             BehaviourSetDefinition(self.push.name, lambda obs: self.opposite_pushed(obs) and not self.push.done,
                                    self.push, rates=rates),
@@ -440,6 +442,5 @@ class GenghisBoxPusher:
             self.active = command.behaviour
             if self.active == GO_HOME:
                 self.went_home_at = obs.time
-        standing = GO_HOME if self.active == GO_HOME else push_task(self.end)
-        return announce(command, standing, self.knowledge)
+        return announce(command, push_task(self.end), self.knowledge)
 

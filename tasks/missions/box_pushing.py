@@ -6,7 +6,7 @@ another R-2 ("green") or Genghis-II ("genghis") its right end (left and right as
 looking east). They push the ends in turn under ALLIANCE (:mod:`teamsim.controllers.behaviours.box_pushing`),
 and the box crosses the room through the contact forces of their pushes. The mission completes when the box's
 centre has advanced ``advance`` m along its starting normal (3 m by default, past the middle of the room, which two
-R-2s take about 7.5 minutes over; the thesis says only "across a room").
+R-2s take about 8 minutes over; the thesis says only "across a room").
 
 Parker's experiments are faults: ``remove:green@T`` takes an R-2 away (§6.1.2 "seized and switched off"),
 ``revive:green@T`` brings it back, ``add-robot:genghis@T,kind=genghis2`` brings Genghis-II in. A robot that
@@ -43,7 +43,6 @@ KINDS = ("r2", "genghis2")
 # R-2's fingertips are then 6 cm from it, Genghis-II's whiskers 5 cm).
 STAND_BACK = {"r2": math.hypot(R2Dims().back_x, R2Dims().width / 2) + 0.01,
               "genghis2": math.hypot(Genghis2Dims().length, Genghis2Dims().width) / 2 + 0.01}
-END_INSET = BoxPushParams.end_inset  # m in from the end along the box, where a robot pushes
 CLEAR = 0.6  # m: an end with a live robot nearer than this is taken, when a robot enters
 
 
@@ -73,13 +72,15 @@ class PusherSettings:
         "meaning": "the box-pushing behaviours' constants"})
 
 
-def behind_end(box: tuple[float, float, float], dims: BoxDims, end: str, kind: str) -> tuple[float, float, float]:
-    """The pose facing ``end`` of a box at (x, y, yaw), ``STAND_BACK`` behind its back face, ``END_INSET`` in
-    from the end. The box's length lies along its local y; it is pushed along its local +x, so its left end is at +y."""
+def behind_end(box: tuple[float, float, float], dims: BoxDims, end: str, kind: str,
+               inset: float) -> tuple[float, float, float]:
+    """The pose facing ``end`` of a box at (x, y, yaw), ``STAND_BACK`` behind its back face, ``inset`` in from the
+    end (where the robot pushes: ``BoxPushParams.end_inset``). The box's length lies along its local y; it is
+    pushed along its local +x, so its left end is at +y."""
     x, y, yaw = box
     normal, along = np.array([math.cos(yaw), math.sin(yaw)]), np.array([-math.sin(yaw), math.cos(yaw)])
     sign = 1.0 if end == LEFT else -1.0
-    centre = (np.array([x, y]) + along * sign * (dims.length / 2 - END_INSET)
+    centre = (np.array([x, y]) + along * sign * (dims.length / 2 - inset)
               - normal * (dims.depth / 2 + STAND_BACK[kind]))
     return float(centre[0]), float(centre[1]), yaw
 
@@ -97,7 +98,8 @@ class BoxPushingMission(ScenarioMission):
         dims = BoxDims()
         box = (-ROOM[0] / 2 + BOX_START + dims.depth / 2, 0.0, 0.0)
         team = {"red": ("r2", LEFT), ("green" if params.right == "r2" else "genghis"): (params.right, RIGHT)}
-        robots = {name: RobotEntry(kind, behind_end(box, dims, end, kind), controller=PusherSettings(
+        inset = params.behaviour.end_inset
+        robots = {name: RobotEntry(kind, behind_end(box, dims, end, kind, inset), controller=PusherSettings(
             end, behaviour=params.behaviour)) for name, (kind, end) in team.items()}
         for k, (name, kind) in enumerate(newcomers):  # a start pose by the east wall, never used: entry_pose
             if name in robots:                        # sets them down at a free end when they join
@@ -177,14 +179,15 @@ class BoxPushingMission(ScenarioMission):
         mujoco.mj_kinematics(world.model, world.data)
         box, robot = self.box_pose(world), world.robots[name]
         dims = world.scene.scenario.objects.box
-        own = world.scene.scenario.robots[name].controller.end
+        settings = world.scene.scenario.robots[name].controller
+        own, inset = settings.end, settings.behaviour.end_inset
         others = [world.pose(r)[:2] for n, r in world.robots.items() if n != name and r.active]
         for end in (own, OPPOSITE[own]):
-            pose = behind_end(box, dims, end, robot.model.kind)
+            pose = behind_end(box, dims, end, robot.model.kind, inset)
             if all(math.dist(pose[:2], p) >= CLEAR for p in others):
                 break
         else:  # both ends taken: wait 0.8 m further back behind its own end
-            end, pose = own, behind_end(box, dims, own, robot.model.kind)
+            end, pose = own, behind_end(box, dims, own, robot.model.kind, inset)
             pose = (pose[0] - 0.8 * math.cos(box[2]), pose[1] - 0.8 * math.sin(box[2]), box[2])
         world.scene.info["ends"][name] = end
         return pose

@@ -3,10 +3,10 @@ many seeds.
 
 - **robot-failure** (Experiment 1): red and green push; green is taken away (``remove``, "seized and switched
   off") at a random time in ``remove_window`` and put back (``revive``) ``away`` s later; the trial ends
-  ``after_return`` s after that. Measured: the takeover pause, from red's own last push (the one after which
-  green would have pushed) to red's activation of green's end, against the thesis's "about 5 to 8 seconds";
-  also from green's last push complete; whether red then alternates both ends; whether, back, green pushes one
-  end and the pair alternates again.
+  ``after_return`` s after that. Measured: the takeover pause, from green's removal to red's activation of green's
+  end, against the thesis's "about 5 to 8 seconds" (an observer's timing: "seized ... after a brief pause"); also
+  from green's last push complete and from red's own last push; whether red then alternates both ends; whether,
+  back, green pushes one end and the pair splits the ends again.
 - **heterogeneity** (Experiment 2): green is replaced by Genghis-II (``remove`` green and ``add-robot`` genghis at
   the same random time); red is taken away ``with_genghis`` s later; the trial ends ``after_last`` s after that.
   Measured: red's pushes per minute before and with Genghis-II (paired over seeds), Genghis-II's push rate against
@@ -115,11 +115,12 @@ def result_row(study: BoxPushingStudy, config: TrialConfig, summary: dict) -> di
         own, dead, first = takeover(pushes, at)
         away = {e for r, e, _, done in pushes if r == "red" and at <= done < back}
         after = [(r, e) for r, e, _, done in pushes if done >= back + study.settle]
-        split = all(len({e for r, e in after if r == robot}) == 1 for robot in ("red", "green"))
+        ends = [{e for r, e in after if r == robot} for robot in ("red", "green")]
+        split = all(len(e) == 1 for e in ends) and ends[0] != ends[1]
         row.update(second_change_at=back, pause_own_s=own, pause_dead_s=dead, takeover_at=first,
                    survivor_ends="+".join(sorted(away)),
                    returned_pushes=sum(r == "green" for r, _ in after),
-                   pair_split=split and any(r == "green" for r, _ in after),
+                   pair_split=split,
                    red_rate_before=rate(pushes, "red", 0.0, at), red_rate_after=rate(pushes, "red", back + study.settle,
                                                                                        end))
     else:
@@ -129,8 +130,8 @@ def result_row(study: BoxPushingStudy, config: TrialConfig, summary: dict) -> di
         home_s = (summary.get("robots") or {}).get("genghis", {}).get("task_time_s", {}).get("go-home", 0.0)
         row.update(second_change_at=last, red_rate_before=rate(pushes, "red", 0.0, at, "left"),
                    red_rate_after=rate(pushes, "red", at + study.settle, last, "left"),
-                   helper_rate=rate(pushes, "green", 0.0, at), genghis_rate=rate(pushes, "genghis", at + study.settle,
-                                                                                  last),
+                   helper_rate=rate(pushes, "green", 0.0, at, "right"),
+                   genghis_rate=rate(pushes, "genghis", at + study.settle, last),
                    final_genghis=final,
                    go_home_delay_s=round(home_at - last, 1) if final == "go-home" and home_at is not None else None,
                    # go-home time before the last R-2 went: Genghis-II heard nobody at the opposite end for tau
@@ -174,7 +175,8 @@ def _robot_failure(study: BoxPushingStudy, rows: list[dict]) -> list[str]:
              "which, when its news went out, red first answers with one more push at its own end.", "",
              "| what | thesis | teamsim | verdict |", "|---|---|---|---|",
              f"| takeover pause after green's removal (s) | about 5-8 | {_summary(removal)} | {inside}/{n} in 5-8 s; "
-             f"{spread}/{n} within one radio period (3 s) of it | {'yes' if spread == n else 'partly'} |",
+             f"{spread}/{n} within one radio period (3 s) of it | {'yes' if spread == n else 'partly'}: 'about', read "
+             "as within a radio period |",
              f"| the same after green's last push complete (s) | - | {_summary(dead)} | "
              f"{sum(lo <= p <= hi for p in dead if math.isfinite(p))}/{n} in 5-8 s |",
              f"| the same after red's own last push complete (s) | - | {_summary(r['pause_own_s'] for r in rows)} | "

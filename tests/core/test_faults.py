@@ -175,9 +175,18 @@ def test_radio_on_cannot_revive_dead_robot():
 
 def test_radio_off_then_on():
     h = applied("radio-off:red@1")
-    assert h == Health(radio_on=False)
+    assert h == Health(radio_on=False, radio_cut=True)
     apply_fault(parse_fault("radio-on:red@2"), h, MOTORS)
     assert h == Health()
+
+
+def test_revive_switches_a_robot_on_but_not_a_radio_cut_before():
+    h = applied("radio-off:red@1", "remove:red@2")
+    assert not h.alive and h.removed
+    apply_fault(parse_fault("revive:red@3"), h, MOTORS)
+    assert h.alive and not h.radio_on  # a power cycle does not mend a cut radio
+    h = applied("kill:red@1", "revive:red@2")
+    assert h.alive and h.radio_on and not h.removed
 
 
 def test_blind_ir():

@@ -121,3 +121,21 @@ def test_add_robot_joins_at_its_time(tmp_path):
 def test_faults_checked_against_team(tmp_path, spec, message):
     with pytest.raises(ConfigError, match=message):
         make_world(tmp_path, [spec])
+
+
+def test_a_newcomers_faults_come_after_it_joins(tmp_path):
+    with pytest.raises(ConfigError, match="purple joins at 5 s"):
+        make_world(tmp_path, ["add-robot:purple@5,kind=diffdrive", "remove:purple@2"], robots=2)
+
+
+def test_remove_parks_a_robot_and_revive_brings_it_back_with_a_fresh_controller(tmp_path):
+    world, mission, events = make_world(tmp_path, ["remove:red@1", "revive:red@3"], robots=2)
+    red = world.robots["red"]
+    first = red.controller
+    advance_seconds(world, 2.0)
+    assert world.pose(red)[0] > 500 and not red.active, "removed: parked outside the arena, switched off"
+    advance_seconds(world, 1.1)  # revived at 3 s, then 0.1 s of driving at 0.2 m/s
+    x, y, _ = world.pose(red)
+    assert (x, y) == pytest.approx(red.spawn[:2], abs=0.05), "no entry_pose: back at its start"
+    assert red.active and red.controller is not first
+    assert [e["kind"] for e in fault_events(events)] == ["remove", "revive"]
