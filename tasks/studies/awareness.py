@@ -24,9 +24,10 @@ from teamsim.config import TrialConfig
 from teamsim.faults import Fault
 from teamsim.files import write_atomic, write_csv
 from teamsim.plots import grouped_bars
-from teamsim.stats import paired_t_test
 from teamsim.sweep import run_trials
 from teamsim.tasks.missions.hazardous_waste import TEAMS, HazardousWasteParams
+from teamsim.tasks.studies import findings
+from teamsim.tasks.studies.findings import Finding, verdict
 
 VERSIONS = {"I": (2, True), "II": (3, True), "III": (2, False), "IV": (3, False)}  # (robots, awareness)
 COLUMNS = ("version", "robots", "awareness", "mission", "seed", "status", "completed", "mission_time_s",
@@ -95,29 +96,9 @@ def pooled_ratio(rows: list[dict], numerator: str, denominator: str, version: st
     return sum(r[numerator] for r in chosen) / total if total else math.nan
 
 
-@dataclass(frozen=True)
-class Finding:
-    claim: str
-    thesis: str
-    teamsim: str
-    verdict: str  # "yes": the thesis's criterion holds as stated; "partly"; "**no**"; "n/a": not measured
-    p: float = math.nan  # paired two-sided t-test over the seeds, for the comparison the claim turns on
-
-
-def per_seed(rows: list[dict], key: str, version: str) -> dict[int, float]:
-    """The version's value of ``key`` per seed, completed missions only."""
-    return {r["seed"]: r[key] for r in rows if r["version"] == version and r["completed"] and r[key] is not None}
-
-
 def paired_p(rows: list[dict], key: str, a: str, b: str) -> float:
     """p of versions a and b differing in ``key``, paired by seed (both completed)."""
-    first, second = per_seed(rows, key, a), per_seed(rows, key, b)
-    seeds = sorted(set(first) & set(second))
-    return paired_t_test([first[s] for s in seeds], [second[s] for s in seeds])[1]
-
-
-def verdict(held: int, of: int) -> str:
-    return "n/a" if of == 0 else "yes" if held == of else "partly" if held else "**no**"
+    return findings.paired_p(rows, key, "version", a, b)
 
 
 def claims(rows: list[dict]) -> list[Finding]:
@@ -183,16 +164,8 @@ def write_report(study: AwarenessStudy, rows: list[dict]) -> None:
              "radio off from t = 0. Means are over completed missions; ratios pool all missions. "
              "Per-mission rows: `results.csv`.", "",
              "## Findings against the thesis", "",
-             "**yes** where the thesis's statement holds as worded (every pair of an ordering; a figure within 0.15, "
-             "or 0.3 for pucks per transport), **partly** where some of it does, **no** where none does. p: paired "
-             "two-sided t-test over the seeds for the comparison the claim turns on (the weakest pair of an "
-             "ordering); with 10 missions a version, p >= 0.05 means this sample does not decide it.", "",
-             "| claim | thesis | teamsim | p | reproduced |", "|---|---|---|---|---|"]
-    for found in claims(rows):
-        undecided = found.p >= 0.05 and found.verdict != "**no**"
-        lines.append(f"| {found.claim} | {found.thesis} | {found.teamsim} | "
-                     f"{'-' if math.isnan(found.p) else f'{found.p:.2g}'} | "
-                     f"{found.verdict}{', not decided by this sample' if undecided else ''} |")
+             *findings.table(claims(rows), " (every pair of an ordering; a figure within 0.15, or 0.3 for pucks per "
+                                           "transport)")]
     lines += ["", "![time and energy](versions.png)", "", "## Versions", "",
               "| version | robots | awareness | completed | time (s) | energy (Parker units) | energy (J) | "
               "transports | pucks/transport | reports/move | robots running find |",

@@ -109,3 +109,34 @@ def test_results_tables_have_their_columns(tmp_path, columns):
     write_csv(tmp_path / "r.csv", columns, [dict.fromkeys(columns, 1)])
     with open(tmp_path / "r.csv", newline="") as handle:
         assert tuple(csv.DictReader(handle).fieldnames) == tuple(columns)
+
+
+def test_fault_report_gives_the_theses_findings_with_verdicts_and_p(tmp_path):
+    """Radio-off's reports per move above the radio's in every mission: yes, decided; its energy above in one of
+    two with the mean below: no. A takeover in one of two kill-red missions: partly."""
+    rows = [row("none", seed=0, reports=1, transports=7, energy_parker_units=1000.0),
+            row("none", seed=1, reports=1, transports=7, energy_parker_units=1200.0),
+            row("kill-red", seed=0, takeover="green"), row("kill-red", seed=1),
+            row("radio-off", seed=0, reports=3, transports=7, energy_parker_units=1100.0,
+                find_robots="blue+green+red"),
+            row("radio-off", seed=1, reports=4, transports=7, energy_parker_units=900.0,
+                find_robots="blue+green+red")]
+    found = {f.claim.split(" (")[0].split(":")[0]: f for f in cf.claims(rows)}
+    reports = found["without awareness report-progress is repeated"]
+    assert reports.verdict == "yes" and "higher in 2/2" in reports.teamsim and reports.p < 0.2
+    energy = found["awareness saves energy"]
+    assert energy.verdict == "**no**" and "higher in 1/2" in energy.teamsim
+    assert found["red killed during its search"].verdict == "partly"
+    assert found["without awareness every capable robot runs find-locations"].verdict == "yes"
+    text = cf.report(cf.CleanupFaultStudy(missions=2, conditions=("none", "kill-red", "radio-off"), out=tmp_path),
+                     rows)
+    assert "## Findings against the thesis" in text and "| yes |" in text
+
+
+def test_fault_results_read_back_as_written(tmp_path):
+    from teamsim.files import write_csv
+    rows = [row("none", seed=3, fault_time=None), row("kill-red", seed=3, fault_time=42.5, takeover="green")]
+    write_csv(tmp_path / "results.csv", cf.COLUMNS, rows)
+    back = cf.read_results(tmp_path / "results.csv")
+    assert [(r["condition"], r["seed"], r["fault_time"], r["completed"], r["transports"]) for r in back] == [
+        ("none", 3, None, True, 6), ("kill-red", 3, 42.5, True, 6)]
