@@ -45,6 +45,7 @@ import numpy as np
 
 from teamsim.files import write_atomic, write_csv
 from teamsim.rng import RandomStreams
+from teamsim.stats import paired_t_test
 from teamsim.tasks.worlds.abstract_allocation import (TeamSettings, draw_problem, optimal_energy, optimal_time,
                                                       run_team)
 
@@ -307,17 +308,33 @@ NEAR_WORST = 5.0  # claim 12: a worst case within 5 points of the thesis's % ove
 @dataclass
 class Verdict:
     """One claim of the thesis, teamsim's figure beside it, and the disagreements found: (cause key of
-    :data:`CAUSES`, text). A measured claim is reproduced exactly when it has no disagreement."""
+    :data:`CAUSES`, text). A measured claim is reproduced exactly when it has no disagreement. ``cells`` and
+    ``held``: how many cells (settings, regions, problems) the claim was checked in and held in; ``p``: the paired
+    two-sided t-test of the cell furthest from the claim, where the claim compares strategies run by run."""
 
     claim: str
     thesis: str
     teamsim: str
     measured: bool = True
     flags: list = field(default_factory=list)
+    cells: int = 1
+    held: int | None = None  # None: every cell but one per disagreement
+    p: float = math.nan
 
     @property
     def reproduced(self) -> bool | None:
         return (not self.flags) if self.measured else None
+
+    @property
+    def holding(self) -> int:
+        return self.held if self.held is not None else max(self.cells - len(self.flags), 0)
+
+    @property
+    def word(self) -> str:
+        """yes (no disagreement), partly (some cells hold), no (none does), n/a (not measured)."""
+        if not self.measured:
+            return "n/a"
+        return "yes" if not self.flags else "partly" if self.holding else "**no**"
 
     def flag(self, cause: str, text: str) -> None:
         assert cause in CAUSES, cause
@@ -354,13 +371,18 @@ def _preferred(means: dict[str, float], strategies=("I", "II", "III")) -> list[s
     return [s for s in strategies if means[s] <= best * (1 + TIE_TOLERANCE)]
 
 
-def _pooled(groups: dict, keep) -> dict[str, float]:
+def _pooled_runs(groups: dict, keep) -> dict[str, list[float]]:
+    """Each strategy's ratios over the kept groups, problem by problem in the same order for every strategy."""
     values = defaultdict(list)
     for key, group in groups.items():
         if keep(key):
             for strategy, ratios in group.items():
                 values[strategy] += ratios
-    return {s: float(np.mean(v)) for s, v in values.items()}
+    return values
+
+
+def _pooled(groups: dict, keep) -> dict[str, float]:
+    return {s: float(np.mean(v)) for s, v in _pooled_runs(groups, keep).items()}
 
 
 def _table_rows(groups: dict, thesis: dict, name: str) -> tuple[list[str], Verdict]:
@@ -394,24 +416,30 @@ def _table_rows(groups: dict, thesis: dict, name: str) -> tuple[list[str], Verdi
         lines.append(f"| {label[0]} | {label[1]} | {label[2]} | {expected} | {' '.join(ours)} "
                      f"({means['I']:.3f} / {means['II']:.3f} / {means['III']:.3f}) | {word} |")
     verdict.measured = sum(counts.values()) > 0
+    verdict.cells, verdict.held = sum(counts.values()), counts["same"]
     verdict.teamsim = (f"{counts['same']} rows the same, {counts['overlaps']} overlapping, "
                        f"{counts['**differs**']} different")
     return lines, verdict
 
 
 def _strategy_iv_rows(groups_time: dict, groups_energy: dict) -> tuple[list[str], Verdict]:
-    lines = ["| PWW | region | heterogeneity | IV / best of I-III, time | energy | verdict |",
+    lines = ["| PWW | region | heterogeneity | IV / best of I-III, time (p) | energy (p) | verdict |",
              "|---|---|---|---|---|---|"]
     verdict = Verdict("9: strategy IV", "as good as or better than I-III in time and energy in every region, "
                       "heterogeneity and PWW setting, except region 2, mild, no PWW (III slightly better)", "")
     cells = good = 0
+    furthest = 0.0  # the largest IV / best ratio, whose p the claim reports
     for key in sorted(groups_time, key=lambda k: (not k[0], k[1], k[2])):
         if key[2] in ("none", "between") or "IV" not in groups_time[key]:
             continue
-        ratios = {}
+        ratios, ps = {}, {}
         for metric, groups in (("time", groups_time), ("energy", groups_energy)):
             means = {s: float(np.mean(v)) for s, v in groups[key].items()}
-            ratios[metric] = means["IV"] / min(means[s] for s in ("I", "II", "III"))
+            best = min(("I", "II", "III"), key=means.get)
+            ratios[metric] = means["IV"] / means[best]
+            ps[metric] = paired_t_test(groups[key]["IV"], groups[key][best])[1]
+            if ratios[metric] > furthest:
+                furthest, verdict.p = ratios[metric], ps[metric]
         worse = [metric for metric, ratio in ratios.items() if ratio > 1 + TIE_TOLERANCE]
         where = f"PWW {'yes' if key[0] else 'no'}, region {key[1]}, {key[2]} heterogeneity"
         cells += 1
@@ -427,9 +455,10 @@ def _strategy_iv_rows(groups_time: dict, groups_energy: dict) -> tuple[list[str]
                 "iv_energy" if worse == ["energy"] else "unexplained")
             verdict.flag(cause, f"strategy IV worse than the best of I-III in {' and '.join(worse)}: {where} "
                                 f"(time x{ratios['time']:.3f}, energy x{ratios['energy']:.3f})")
-        lines.append(f"| {'yes' if key[0] else 'no'} | {key[1]} | {key[2]} | {ratios['time']:.3f} | "
-                     f"{ratios['energy']:.3f} | {word} |")
+        lines.append(f"| {'yes' if key[0] else 'no'} | {key[1]} | {key[2]} | {ratios['time']:.3f} "
+                     f"({ps['time']:.2g}) | {ratios['energy']:.3f} ({ps['energy']:.2g}) | {word} |")
     verdict.measured = cells > 0
+    verdict.cells, verdict.held = cells, good
     verdict.teamsim = f"as good or better (or the thesis's exception) in {good} of {cells} cells"
     return lines, verdict
 
@@ -477,12 +506,20 @@ def _region1(groups_time: dict, groups_energy: dict, rows: list[dict], default_b
     verdict = Verdict("8: region 1", "II and III much better than I, in time and in energy", "")
     share = _fastest_share(rows, default_boredom)
     lines, figures = [], []
+    verdict.cells = verdict.held = 0
+    weakest = -math.inf
     for pww in (True, False):
         for metric, groups in (("time", groups_time), ("energy", groups_energy)):
-            means = _pooled(groups, lambda k: k[0] == pww and k[1] == 1 and k[2] != "none")
-            if not all(s in means for s in ("I", "II", "III")):
+            runs = _pooled_runs(groups, lambda k: k[0] == pww and k[1] == 1 and k[2] != "none")
+            if not all(s in runs for s in ("I", "II", "III")):
                 continue
+            means = {s: float(np.mean(v)) for s, v in runs.items()}
             change = {s: means[s] / means["I"] - 1 for s in ("II", "III")}
+            for s in ("II", "III"):
+                verdict.cells += 1
+                verdict.held += change[s] <= -MUCH_BETTER
+                if change[s] > weakest:
+                    weakest, verdict.p = change[s], paired_t_test(runs[s], runs["I"])[1]
             setting = f"PWW {'yes' if pww else 'no'}, {metric}"
             figures.append(f"{setting}: II {100 * change['II']:+.1f} %, III {100 * change['III']:+.1f} %")
             lines.append(f"  - {setting}, mean over the mean of I-III: I {means['I']:.3f}, II {means['II']:.3f}, III "
@@ -512,7 +549,7 @@ def _ordering_lines(rows: list[dict]) -> tuple[list[str], list[Verdict]]:
     if not ordering:
         return ["Not measured in this run."], [random_claim, longest_claim]
     times: dict[tuple, list[float]] = defaultdict(list)
-    for r in ordering:
+    for r in sorted(ordering, key=lambda r: r["run"]):  # run by run, the same problems under every ordering
         times[(r["strategy"], r["ordering"])].append(r["time"])
     lines = ["| strategy | Shortest Task First, mean time | Random, mean time | random vs STF | thesis |",
              "|---|---|---|---|---|"]
@@ -523,6 +560,13 @@ def _ordering_lines(rows: list[dict]) -> tuple[list[str], list[Verdict]]:
         change[s] = rnd / stf - 1
         lines.append(f"| {s} | {stf:.1f} | {rnd:.1f} | {100 * change[s]:+.1f} % | {expectation[s]} |")
     random_claim.teamsim = ", ".join(f"{s} {100 * change[s]:+.1f} %" for s in ("I", "II", "III"))
+    expected = {"I": change["I"] > max(change["III"], 0), "III": change["I"] > change["III"] > 0,
+                "II": change["II"] < 0}
+    random_claim.cells, random_claim.held = 3, sum(expected.values())
+    ps = {s: paired_t_test(times[(s, "random")], times[(s, "shortest_first")])[1] for s in ("I", "II", "III")}
+    random_claim.p = max(ps.values())
+    lines += ["", "p (random against Shortest Task First, paired run by run): " + ", ".join(
+        f"{s} {ps[s]:.2g}" for s in ("I", "II", "III")) + "."]
     if not change["I"] > change["III"] > 0:
         random_claim.flag("ordering", f"random selection: thesis I degrades most, III somewhat; teamsim I "
                                       f"{100 * change['I']:+.1f} %, III {100 * change['III']:+.1f} %")
@@ -587,7 +631,7 @@ def _optimal_lines(rows: list[dict]) -> tuple[list[str], list[Verdict]]:
         return ["Not measured in this run."], verdicts
     lines: list[str] = []
     worst_of: dict[tuple, tuple] = {}  # (pww, metric) -> (triple, % over optimal)
-    highest, ranks, worst_texts = [], [], []
+    highest, ranks, worst_texts, means_checked = [], [], [], []
     for pww in sorted({p for p, _ in over}):
         mine = {t: d for (p, t), d in over.items() if p == pww}
         setting = "with Progress When Working" if pww else "without Progress When Working"
@@ -617,6 +661,7 @@ def _optimal_lines(rows: list[dict]) -> tuple[list[str], list[Verdict]]:
         lines.append("")
         top = max(summary, key=summary.get)
         highest.append(f"{short}: highest region mean {summary[top]:.1f} % (region {top[0]}, {top[1]})")
+        means_checked += summary.values()
         for (region, metric), mean in summary.items():
             if mean >= UNDER_OPTIMAL:
                 mean_claim.flag("optimal", f"{setting}, region {region}: strategy IV {mean:.1f} % over optimal in "
@@ -630,11 +675,15 @@ def _optimal_lines(rows: list[dict]) -> tuple[list[str], list[Verdict]]:
                     region1_claim.flag("unexplained", f"{setting}, region 1 is not the best region in {metric} "
                                                       "(thesis: 'much better performance in region 1')")
     mean_claim.teamsim = "; ".join(highest)
+    mean_claim.cells = len(means_checked)
+    mean_claim.held = sum(mean < UNDER_OPTIMAL for mean in means_checked)
+    region1_claim.cells = max(len(ranks), 1)
     region1_claim.teamsim = "; ".join(ranks) or "fewer than two regions measured"
     region1_claim.measured = bool(ranks)
     compared = len({t for _, t in over})
     worst_claim.teamsim = "; ".join(worst_texts) + f" (over the {compared} triples of this run)"
     subset = "" if compared >= THESIS_TRIPLES else f"; this run compares {compared} of the {THESIS_TRIPLES} triples"
+    worst_claim.cells = len(THESIS_WORST)
     for metric, (thesis_triple, thesis_over) in THESIS_WORST.items():
         found = {pww: worst_of[(pww, metric)] for pww in (0, 1) if (pww, metric) in worst_of}
         if any(abs(value - thesis_over) > NEAR_WORST for _, value in found.values()):
@@ -654,12 +703,15 @@ def _analysis(rows: list[dict], study: StudyPlan) -> tuple[dict[str, list[str]],
     zero_total, zero_differ = _identical_at_zero(rows)
     zero = Verdict("8: 0 % heterogeneity", "I, II and III identical",
                    f"different results on {zero_differ} of {zero_total} problems", measured=zero_total > 0)
+    zero.cells, zero.held = zero_total, zero_total - zero_differ
     if zero_differ:
         zero.flag("unexplained", f"I-III differ at 0 % heterogeneity on {zero_differ} problems")
     region4 = [max(means) - min(means) for k, v in groups_time.items() if k[1] == 4 and k[2] != "none"
                for means in ([np.mean(v[s]) for s in ("I", "II", "III")],)]
     no_difference = Verdict("8: region 4", "no difference between I-III",
                             f"largest difference {100 * max(region4):.1f} %" if region4 else "", measured=bool(region4))
+    no_difference.cells = len(region4)
+    no_difference.held = sum(d <= TIE_TOLERANCE for d in region4)
     if region4 and max(region4) > TIE_TOLERANCE:
         no_difference.flag("region4", f"I-III differ by up to {100 * max(region4):.1f} %")
     region1_lines, region1 = _region1(groups_time, groups_energy, rows, default_boredom)
@@ -698,10 +750,12 @@ def report(rows: list[dict], study: StudyPlan, seed: int, wall: float, workers: 
     under Disagreements with its cause."""
     sections, verdicts = _analysis(rows, study)
     settings = asdict(study.settings)
-    glance = ["| claim | thesis | teamsim | verdict |", "|---|---|---|---|"]
+    glance = ["| claim | thesis | teamsim | cells holding | p | verdict |", "|---|---|---|---|---|---|"]
     for v in verdicts:
-        word = {None: "not measured", True: "reproduced", False: "**not reproduced** (see Disagreements)"}
-        glance.append(f"| {v.claim} | {v.thesis} | {v.teamsim if v.measured else '—'} | {word[v.reproduced]} |")
+        p = "—" if math.isnan(v.p) else f"{v.p:.2g}"
+        undecided = ", not decided by this sample" if v.p >= 0.05 and v.word == "yes" else ""
+        glance.append(f"| {v.claim} | {v.thesis} | {v.teamsim if v.measured else '—'} | "
+                      f"{f'{v.holding}/{v.cells}' if v.measured else '—'} | {p} | {v.word}{undecided} |")
     out = [
         "# L-ALLIANCE allocation study (Parker 1994, §4.5) regenerated by teamsim", "",
         f"Seed {seed}; {len(rows)} runs in {wall:.1f} s on {workers} worker(s). Runs per scenario: {study.runs} "
@@ -729,7 +783,10 @@ def report(rows: list[dict], study: StudyPlan, seed: int, wall: float, workers: 
         "496 (331/139/26); the bounds it states, n^m < 2^17 (footnote 4) and <= 2^17 (text), would add (7, 6, 2..7) "
         "and (2, 17, 2).", "",
         "## Claims at a glance", "",
-        "A claim counts as reproduced only when it has no disagreement below.", "", *glance, "",
+        "**yes** where a claim has no disagreement below (it holds in every cell it was checked in), **partly** "
+        "where it holds in some cells, **no** where it holds in none. p: paired two-sided t-test, run by run on the "
+        "same problems, of the cell furthest from the claim (for claims that compare strategies); p >= 0.05 means "
+        "this sample does not decide that cell.", "", *glance, "",
         "## Claim 8: strategies identical at 0 % heterogeneity; no difference in region 4; II, III beat I in region 1",
         "", *sections["claim8"], "",
         "## Table 4.2 regenerated (time)", "", *sections["table_time"], "",

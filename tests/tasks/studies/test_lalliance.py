@@ -150,4 +150,4 @@ def test_study_writes_csv_and_report_and_is_deterministic(tmp_path):
     assert "different results on 0 of" in report
     assert "teamsim counts" not in report  # the triple count is the thesis's: not flagged
     assert "| 12: triples | 496 triples, 331/139/26 in regions 1/2/3 | 496 triples, 331/139/26 in regions 1/2/3 | " \
-           "reproduced |" in report
+           "1/1 | — | yes |" in report

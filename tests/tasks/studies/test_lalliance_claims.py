@@ -114,7 +114,9 @@ def test_claim_8_region_1_ii_and_iii_much_better_than_i(region1_rows):
     found = listed(text)
     assert any(line.startswith("Claim 8: region 1: PWW yes, time: III") for line in found["region1_iii"])
     assert any(line.startswith("Claim 8: region 1: PWW no, time: II") for line in found["region1_ii"])
-    assert "| 8: region 1 |" in text and "**not reproduced** (see Disagreements)" in text.split("| 8: region 1 |")[1]
+    glance_row = text.split("| 8: region 1 |")[1].split("\n")[0]
+    assert glance_row.endswith(" | partly |") or glance_row.endswith(" | **no** |")
+    assert f"| {verdict.holding}/{verdict.cells} |" in glance_row and verdict.holding < verdict.cells
     # The table rows behind the same claim ("II or III" in region 1) are listed too, not only marked "overlaps".
     assert any(line.startswith("Claim 8: Table 4.2: PWW yes, region 1") for line in found["table"])
 
@@ -217,3 +219,19 @@ def test_every_claim_not_reproduced_is_listed_with_its_cause(region1_rows, strat
             assert mine == {(cause, f"Claim {v.claim}: {text}") for cause, text in v.flags}
         else:
             assert not mine and not v.flags
+
+
+def test_a_verdict_says_yes_partly_or_no_by_the_cells_that_hold():
+    from teamsim.tasks.studies.lalliance import Verdict
+    held_everywhere = Verdict("c", "t", "f", cells=4, held=4)
+    assert (held_everywhere.word, held_everywhere.holding) == ("yes", 4)
+    some = Verdict("c", "t", "f", cells=4, held=1)
+    some.flag("unexplained", "three cells do not hold")
+    assert some.word == "partly"
+    none = Verdict("c", "t", "f", cells=2, held=0)
+    none.flag("unexplained", "no cell holds")
+    assert none.word == "**no**"
+    one_cell = Verdict("c", "t", "f")  # a single check: a disagreement leaves no cell holding
+    one_cell.flag("unexplained", "it does not hold")
+    assert (one_cell.holding, one_cell.word) == (0, "**no**")
+    assert Verdict("c", "t", "f", measured=False).word == "n/a"
