@@ -133,8 +133,8 @@ def run_trial(config: TrialConfig, seed: int | None = None, progress: bool | Non
             "robots": list(world.robots)})
 
     def capture() -> None:
-        behaviours = [r.behaviour if r.active else ("dead" if not r.health.alive else "absent")
-                      for r in world.robots.values()]
+        behaviours = [r.behaviour if r.active else ("absent" if r.dormant or r.health.removed else "dead")
+                      for r in world.robots.values()]  # (a removed robot is out of the arena: absent)
         recorder.capture(world.time, world.data.qpos, behaviours)
         if video is not None:
             video.write(world.time, world.data.qpos, behaviours)
