@@ -3,13 +3,13 @@ several runs at once in parallel worker processes, one core each."""
 from __future__ import annotations
 
 import concurrent.futures as futures
-import multiprocessing
 import os
 from pathlib import Path
 
 from teamsim.config import ConfigError
 from teamsim.progress import Progress
 from teamsim.recording import load_trajectory
+from teamsim.sweep import worker_pool
 
 
 def trajectory_of(run_dir: Path) -> Path:
@@ -53,8 +53,7 @@ def rerender_all(run_dirs: list[Path], camera: str = "top", width: int = 640, he
     if workers == 1:
         return [rerender(run_dir, camera, None, width, height) for run_dir in run_dirs]
     bar = Progress(len(run_dirs), f"render {len(run_dirs)} runs on {workers} workers", unit="runs done")
-    context = multiprocessing.get_context("spawn")  # a GL context does not survive a fork
-    with futures.ProcessPoolExecutor(max_workers=workers, mp_context=context) as pool:
+    with worker_pool(workers) as pool:  # spawned: a GL context does not survive a fork
         jobs = [pool.submit(rerender, run_dir, camera, None, width, height, False) for run_dir in run_dirs]
         for done, _ in enumerate(futures.as_completed(jobs), start=1):
             bar.update(done)

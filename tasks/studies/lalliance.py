@@ -33,9 +33,7 @@ this module). Boundaries of the regions (p.95 gives open intervals): coverage/m 
 """
 from __future__ import annotations
 
-import concurrent.futures as futures
 import math
-import multiprocessing
 import time
 from collections import defaultdict
 from dataclasses import asdict, dataclass, field
@@ -46,6 +44,7 @@ import numpy as np
 from teamsim.files import write_atomic, write_csv
 from teamsim.rng import RandomStreams
 from teamsim.stats import paired_t_test
+from teamsim.sweep import worker_pool
 from teamsim.tasks.worlds.abstract_allocation import (TeamSettings, draw_problem, optimal_energy, optimal_time,
                                                       run_team)
 
@@ -231,8 +230,7 @@ def run_jobs(jobs: list[ScenarioJob], workers: int) -> list[dict]:
         results = [run_scenario(job) for job in jobs]
     else:
         order = sorted(range(len(jobs)), key=lambda k: -_expected_cost(jobs[k]))
-        context = multiprocessing.get_context("spawn")
-        with futures.ProcessPoolExecutor(max_workers=workers, mp_context=context) as pool:
+        with worker_pool(workers) as pool:
             done = dict(zip(order, pool.map(run_scenario, [jobs[k] for k in order], chunksize=1)))
         results = [done[k] for k in range(len(jobs))]
     return [row for rows in results for row in rows]

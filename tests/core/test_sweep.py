@@ -1,5 +1,13 @@
-"""Sweeps: trials in spawned worker processes give the same results as trials run one by one."""
+"""Sweeps: trials in spawned worker processes give the same results as trials run one by one, and the workers die
+with their parent."""
 from __future__ import annotations
+
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
 
 import pytest
 
@@ -49,3 +57,38 @@ def test_ray_backend_matches_the_process_pool(tmp_path):
     for seed in (4, 5):
         assert ((tmp_path / "ray" / "wander" / f"s{seed}" / "events.jsonl").read_bytes()
                 == (tmp_path / "pool" / "wander" / f"s{seed}" / "events.jsonl").read_bytes())
+
+
+def _alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    return True
+
+
+def test_workers_die_with_a_killed_parent(tmp_path):
+    """SIGKILL on a sweep's parent leaves no worker running its trial on (they used to run on, re-parented)."""
+    repo = Path(__file__).resolve().parents[2]
+    parent = subprocess.Popen([sys.executable, "-m", "tests.core.sweep_sleeper", str(tmp_path)], cwd=repo,
+                              stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    try:
+        for _ in range(300):  # the workers start within a few seconds (spawn imports teamsim)
+            if len(list(tmp_path.glob("worker-*"))) == 2:
+                break
+            time.sleep(0.1)
+        workers = [int(p.read_text()) for p in tmp_path.glob("worker-*")]
+        assert len(workers) == 2
+        parent.kill()
+        parent.wait()
+        for _ in range(50):  # a worker looks for its parent every PARENT_CHECK_S (0.5 s)
+            if not any(_alive(pid) for pid in workers):
+                break
+            time.sleep(0.1)
+        assert not any(_alive(pid) for pid in workers)
+    finally:
+        parent.kill()
+        for p in tmp_path.glob("worker-*"):
+            pid = int(p.read_text())
+            if _alive(pid):
+                os.kill(pid, signal.SIGKILL)
