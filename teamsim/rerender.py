@@ -3,6 +3,7 @@ several runs at once in parallel worker processes, one core each."""
 from __future__ import annotations
 
 import concurrent.futures as futures
+import json
 import os
 from pathlib import Path
 
@@ -15,8 +16,24 @@ from teamsim.sweep import worker_pool
 def trajectory_of(run_dir: Path) -> Path:
     path = Path(run_dir) / "trajectory.npz"
     if not path.is_file():
-        raise ConfigError(f"RUN_DIR {run_dir}: no trajectory.npz there")
+        raise ConfigError(f"RUN_DIR {run_dir}: no trajectory.npz there{_why_missing(Path(run_dir))}")
     return path
+
+
+def _why_missing(run_dir: Path) -> str:
+    """What the run's summary says about a missing trajectory: a run cut off (killed), or one still running."""
+    from teamsim.runner import cut_off  # (the runner imports every mission; only needed on this error path)
+
+    try:
+        summary = json.loads((run_dir / "summary.json").read_text())
+    except (OSError, ValueError):
+        return ""
+    if cut_off(summary):
+        return (f" (the run was cut off: its process {summary['pid']} is gone and its summary still says "
+                "'running'; nothing after its start was saved)")
+    if summary.get("status") == "running":
+        return " (the run is still going)"
+    return ""
 
 
 def rerender(run_dir: Path, camera: str = "top", out: Path | None = None, width: int = 640,

@@ -2,13 +2,19 @@
 trial's outputs").
 
 A trial ends ``completed`` or ``failed`` (the mission's verdict), ``unstable`` (NaN/Inf or a MuJoCo warning
-that invalidates the physics), ``error`` (a Python exception) or ``interrupted`` (Ctrl-C). Whatever the ending,
-the summary, the events so far and the trajectory so far are saved.
+that invalidates the physics), ``error`` (a Python exception) or ``interrupted`` (Ctrl-C or SIGTERM). Whatever
+the ending, the summary, the events so far and the trajectory so far are saved. Only SIGKILL (or a machine that
+stops) leaves a summary saying ``running``; it names the process and host, so :func:`cut_off` can tell.
 """
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import hashlib
+import os
+import signal
+import socket
+import threading
 import time
 import traceback
 from dataclasses import dataclass
@@ -95,6 +101,43 @@ def simulate(world: World, mission, duration: float, recorder: TrajectoryRecorde
     world.check_stable()
 
 
+class Terminated(BaseException):
+    """SIGTERM arrived during a trial: it ends as ``interrupted``, with every output written (as Ctrl-C does)."""
+
+
+def _raise_terminated(signum, frame) -> None:
+    raise Terminated()
+
+
+@contextlib.contextmanager
+def _sigterm_interrupts():
+    """While a trial runs in the main thread, SIGTERM raises :class:`Terminated` there (else it kills the process
+    with nothing saved); the previous handler comes back afterwards."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous = signal.signal(signal.SIGTERM, _raise_terminated)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+
+
+def cut_off(summary: dict) -> bool:
+    """A run whose summary still says ``running`` though the process that ran it (on this machine) is gone: it was
+    killed by SIGKILL or the machine stopped, and its trajectory, timeline and video were never written. A run of
+    another machine cannot be told apart from a live one: False."""
+    if summary.get("status") != "running" or summary.get("host") != socket.gethostname():
+        return False
+    try:
+        os.kill(int(summary["pid"]), 0)
+    except ProcessLookupError:
+        return True
+    except (OSError, KeyError, TypeError, ValueError):
+        return False
+    return False
+
+
 def run_trial(config: TrialConfig, seed: int | None = None, progress: bool | None = None) -> TrialResult:
     """Run one trial and write its outputs. ``seed`` overrides ``config.seed``. Bad configuration raises
     ConfigError before anything is written; everything after that ends in a saved summary."""
@@ -114,6 +157,7 @@ def run_trial(config: TrialConfig, seed: int | None = None, progress: bool | Non
             raise ConfigError(f"video.camera: {exc}") from None
     run_dir = make_run_dir(config)
     summary = {"mission": config.mission, "seed": config.seed, "run_id": run_dir.name, "status": "running",
+               "pid": os.getpid(), "host": socket.gethostname(),
                "completed": False, "duration_s": duration, "teamsim": teamsim.__version__,
                "mujoco": mujoco.__version__,
                "config": {k: v for k, v in dataclasses.asdict(config).items() if k != "scenario"},
@@ -142,7 +186,8 @@ def run_trial(config: TrialConfig, seed: int | None = None, progress: bool | Non
     status, error, completed, metrics = "running", None, False, {}
     started = time.perf_counter()
     try:
-        simulate(world, mission, duration, recorder, capture, bar.update)
+        with _sigterm_interrupts():
+            simulate(world, mission, duration, recorder, capture, bar.update)
         completed, metrics = mission.outcome(world)
         status = "completed" if completed else "failed"
         if hasattr(mission, "write_outputs"):  # what a mission keeps beyond the summary (learned statistics, ...)
@@ -151,6 +196,8 @@ def run_trial(config: TrialConfig, seed: int | None = None, progress: bool | Non
         status, error = "unstable", str(exc)
     except KeyboardInterrupt:
         status, error = "interrupted", "interrupted by the user"
+    except Terminated:
+        status, error = "interrupted", "terminated (SIGTERM)"
     except Exception as exc:  # noqa: BLE001  (any failure must still leave a summary)
         status, error = "error", f"{type(exc).__name__}: {exc}"
         events({"t": round(world.time, 6), "event": "exception", "traceback": traceback.format_exc()})

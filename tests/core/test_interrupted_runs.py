@@ -1,0 +1,62 @@
+"""A run stopped from outside: Ctrl-C (SIGINT) and SIGTERM end it as ``interrupted`` with every output written;
+after SIGKILL its summary still says ``running``, names the process, and the next command that reads the folder
+says the run was cut off. Each case runs ``teamsim run`` in a child process and signals it mid-run."""
+from __future__ import annotations
+
+import json
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+from teamsim.cli.main import main
+from teamsim.runner import cut_off
+
+REPO = Path(__file__).resolve().parents[2]
+
+
+def start_run(out: Path) -> tuple[subprocess.Popen, Path]:
+    """A wander run far longer than the test, once it is simulating (its events log, written as
+    ``events.jsonl.part`` until the run ends, has grown)."""
+    child = subprocess.Popen([sys.executable, "-m", "teamsim.cli", "run", "wander", "--duration", "3600", "--out",
+                              str(out), "--run-id", "signalled"], cwd=REPO, stdout=subprocess.DEVNULL,
+                             stderr=subprocess.DEVNULL)
+    run_dir = out / "wander" / "signalled"
+    events = run_dir / "events.jsonl.part"
+    for _ in range(600):
+        if events.is_file() and events.stat().st_size > 2000:
+            break
+        time.sleep(0.05)
+    else:
+        child.kill()
+        pytest.fail("the run did not start")
+    return child, run_dir
+
+
+@pytest.mark.parametrize("sent, code, error", [(signal.SIGINT, 130, "interrupted by the user"),
+                                               (signal.SIGTERM, 130, "terminated (SIGTERM)")])
+def test_a_signalled_run_ends_interrupted_with_its_outputs(tmp_path, sent, code, error):
+    child, run_dir = start_run(tmp_path)
+    child.send_signal(sent)
+    assert child.wait(timeout=60) == code
+    summary = json.loads((run_dir / "summary.json").read_text())
+    assert (summary["status"], summary["error"]) == ("interrupted", error)
+    assert 0 < summary["sim_time_s"] < 3600
+    assert {"events.jsonl", "trajectory.npz", "timeline.png"} <= set(summary["outputs"])
+    assert json.loads((run_dir / "events.jsonl").read_text().splitlines()[-1])["status"] == "interrupted"
+    assert not cut_off(summary)
+
+
+def test_after_sigkill_the_folder_says_the_run_was_cut_off(tmp_path, capsys):
+    child, run_dir = start_run(tmp_path)
+    child.kill()
+    child.wait(timeout=60)
+    summary = json.loads((run_dir / "summary.json").read_text())  # whole: it is only ever replaced atomically
+    assert summary["status"] == "running" and summary["pid"] == child.pid
+    assert cut_off(summary)
+    assert main(["render", str(run_dir)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "cut off" in err and "\n" not in err
