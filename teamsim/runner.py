@@ -138,6 +138,14 @@ def cut_off(summary: dict) -> bool:
     return False
 
 
+def _outputs(run_dir: Path) -> list[str]:
+    """The files a run wrote beside its summary (none if its folder is gone)."""
+    try:
+        return sorted(p.name for p in run_dir.iterdir() if p.name != "summary.json")
+    except OSError:
+        return []
+
+
 def run_trial(config: TrialConfig, seed: int | None = None, progress: bool | None = None) -> TrialResult:
     """Run one trial and write its outputs. ``seed`` overrides ``config.seed``. Bad configuration raises
     ConfigError before anything is written; everything after that ends in a saved summary."""
@@ -184,6 +192,15 @@ def run_trial(config: TrialConfig, seed: int | None = None, progress: bool | Non
             video.write(world.time, world.data.qpos, behaviours)
 
     status, error, completed, metrics = "running", None, False, {}
+    failed_writes: list[str] = []
+
+    def keep(name: str, write) -> None:
+        """Write one output; a failed write (a full disk, a folder gone) is noted, and the others still go."""
+        try:
+            write()
+        except OSError as exc:
+            failed_writes.append(f"{name} ({exc.strerror or exc})")
+
     started = time.perf_counter()
     try:
         with _sigterm_interrupts():
@@ -200,24 +217,33 @@ def run_trial(config: TrialConfig, seed: int | None = None, progress: bool | Non
         status, error = "interrupted", "terminated (SIGTERM)"
     except Exception as exc:  # noqa: BLE001  (any failure must still leave a summary)
         status, error = "error", f"{type(exc).__name__}: {exc}"
-        events({"t": round(world.time, 6), "event": "exception", "traceback": traceback.format_exc()})
+        keep("events.jsonl", lambda: events({"t": round(world.time, 6), "event": "exception",
+                                             "traceback": traceback.format_exc()}))
     finally:
         bar.finish()
-        events({"t": round(world.time, 6), "event": "trial_end", "status": status})
-        events.close()
-        recorder.save(run_dir / "trajectory.npz", motivation.arrays())
+        keep("events.jsonl", lambda: events({"t": round(world.time, 6), "event": "trial_end", "status": status}))
+        keep("events.jsonl", events.close)
+        keep("trajectory.npz", lambda: recorder.save(run_dir / "trajectory.npz", motivation.arrays()))
         if recorder.times:
-            write_timeline(run_dir / "timeline.png", recorder.times, recorder.behaviour_array(), recorder.robot_names,
-                           [f.describe() for f in config.faults], motivation.series)
+            keep("timeline.png", lambda: write_timeline(
+                run_dir / "timeline.png", recorder.times, recorder.behaviour_array(), recorder.robot_names,
+                [f.describe() for f in config.faults], motivation.series))
         video_failure = video.close() if video is not None else None
         if video_failure:
             error = f"{error}; video: {video_failure}" if error else f"video: {video_failure}"
+        failed_writes = list(dict.fromkeys(failed_writes))
+        if failed_writes:
+            status = "error" if status in ("completed", "failed", "running") else status
+            error = "; ".join(filter(None, [error, "could not write " + ", ".join(failed_writes)]))
         wall = time.perf_counter() - started
         summary.update(status=status, completed=status == "completed", error=error,
                        sim_time_s=round(world.time, 6), wall_time_s=round(wall, 3),
                        real_time_factor=round(world.time / wall, 2) if wall > 0 else None,
                        metrics=metrics, robots=world.robot_summary(), final_state_sha256=state_digest(world),
                        faults=[f.describe() for f in config.faults],
-                       outputs=sorted(p.name for p in run_dir.iterdir() if p.name != "summary.json"))
-        write_json(run_dir / "summary.json", summary)
+                       outputs=_outputs(run_dir))
+        keep("summary.json", lambda: write_json(run_dir / "summary.json", summary))
+        if failed_writes:
+            raise ConfigError(f"--out {run_dir}: could not write {', '.join(dict.fromkeys(failed_writes))}; what "
+                              "was written before is kept")
     return TrialResult(status, run_dir, summary)

@@ -60,3 +60,29 @@ def test_after_sigkill_the_folder_says_the_run_was_cut_off(tmp_path, capsys):
     assert main(["render", str(run_dir)]) == 2
     err = capsys.readouterr().err.strip()
     assert "cut off" in err and "\n" not in err
+
+
+def test_a_write_that_fails_mid_run_is_one_line_exit_2_and_keeps_what_was_written(tmp_path, monkeypatch, capsys):
+    """The disk fills up while the events log grows: the run stops with one line and exit 2; the summary written at
+    the start, and the trajectory and timeline written at the end, are kept (written whole, or not at all)."""
+    from teamsim import recording
+
+    write = recording.EventLog.__call__
+    written = {"n": 0}
+
+    def full_disk(self, event):
+        written["n"] += 1
+        if written["n"] > 40:
+            raise OSError(28, "No space left on device")
+        write(self, event)
+
+    monkeypatch.setattr(recording.EventLog, "__call__", full_disk)
+    code = main(["run", "wander", "--duration", "30", "--out", str(tmp_path), "--run-id", "full"])
+    err = capsys.readouterr().err.strip()
+    assert code == 2 and "\n" not in err
+    assert "could not write events.jsonl (No space left on device)" in err
+    run_dir = tmp_path / "wander" / "full"
+    summary = json.loads((run_dir / "summary.json").read_text())
+    assert summary["status"] == "error" and "No space left on device" in summary["error"]
+    assert {"trajectory.npz", "timeline.png"} <= set(summary["outputs"])
+    assert (run_dir / "events.jsonl").read_text().count("\n") == 40  # the events before the disk filled

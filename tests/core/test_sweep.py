@@ -38,7 +38,7 @@ def test_unknown_backend(tmp_path):
 
 def _without_timing(summary: dict) -> dict:
     """A summary less what depends on the machine and the output folder."""
-    return {k: v for k, v in summary.items() if k not in ("wall_time_s", "real_time_factor", "config")}
+    return {k: v for k, v in summary.items() if k not in ("wall_time_s", "real_time_factor", "config", "pid")}
 
 
 def test_ray_backend_matches_the_process_pool(tmp_path):
