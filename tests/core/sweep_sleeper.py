@@ -10,7 +10,9 @@ from pathlib import Path
 
 def sleepy(job: tuple[str, int]) -> dict:
     folder, k = job
-    (Path(folder) / f"worker-{k}").write_text(str(os.getpid()))
+    part = Path(folder) / f".worker-{k}"
+    part.write_text(str(os.getpid()))
+    os.replace(part, Path(folder) / f"worker-{k}")  # whole or absent: the test reads it while this runs
     time.sleep(60.0)
     return {"status": "completed"}
 
