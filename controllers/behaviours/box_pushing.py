@@ -377,7 +377,7 @@ class GoHome:
         self.home: np.ndarray | None = None
 
     def restart(self) -> None:
-        pass
+        """Nothing to forget between activations: home stays where the robot was first switched on."""
 
     def place(self, fix) -> None:
         if self.home is None:

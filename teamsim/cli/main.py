@@ -101,27 +101,21 @@ def _build_parser() -> argparse.ArgumentParser:
                                                      "2 and 3 robots (versions I-IV)")
     awareness.add_argument("--missions", type=_positive_int("--missions"), default=10, help="missions per version")
     awareness.add_argument("--duration", type=float, help="simulated seconds per mission (mission default if unset)")
-    awareness.add_argument("--workers", type=_positive_int("--workers"), default=2)
-    awareness.add_argument("--seed", type=int, default=0)
-    awareness.add_argument("--out", type=Path, default=Path("renders/study-awareness"))
+    _run_options(awareness, workers=2, out="renders/study-awareness")
 
     faults = studies.add_parser("cleanup-faults", help="Parker §3.8.4: the 3-robot cleanup with red killed during "
                                                        "the search, the radio off, a gripper broken")
     faults.add_argument("--missions", type=_positive_int("--missions"), default=10, help="missions per condition")
     faults.add_argument("--conditions", type=_csv_of("condition", CLEANUP_CONDITIONS), default=CLEANUP_CONDITIONS,
                         help=f"comma-separated: {','.join(CLEANUP_CONDITIONS)}")
-    faults.add_argument("--workers", type=_positive_int("--workers"), default=2)
-    faults.add_argument("--seed", type=int, default=0)
-    faults.add_argument("--out", type=Path, default=Path("renders/study-cleanup-faults"))
+    _run_options(faults, workers=2, out="renders/study-cleanup-faults")
 
     boxes = studies.add_parser("box-pushing", help="Parker §6.1.2: an R-2 taken away and returned; an R-2 replaced "
                                                    "by Genghis-II")
     boxes.add_argument("--trials", type=_positive_int("--trials"), default=20, help="trials per experiment")
     boxes.add_argument("--experiments", type=_csv_of("experiment", BOX_EXPERIMENTS), default=BOX_EXPERIMENTS,
                        help=f"comma-separated: {','.join(BOX_EXPERIMENTS)}")
-    boxes.add_argument("--workers", type=_positive_int("--workers"), default=2)
-    boxes.add_argument("--seed", type=int, default=0)
-    boxes.add_argument("--out", type=Path, default=Path("renders/study-box-pushing"))
+    _run_options(boxes, workers=2, out="renders/study-box-pushing")
 
     bench = commands.add_parser("bench", help="benchmarks")
     bench.add_argument("what", choices=("physics", "cleanup", "box-pushing", "render", "nav", "alliance", "allocate",
@@ -146,6 +140,11 @@ def _trial_arguments(parser: argparse.ArgumentParser) -> None:
 def _sweep_options(parser: argparse.ArgumentParser, full_help: str, workers: int, out: str) -> None:
     """--full, --workers, --seed and --out of a study that runs a reduced grid unless asked for the full one."""
     parser.add_argument("--full", action="store_true", help=full_help)
+    _run_options(parser, workers, out)
+
+
+def _run_options(parser: argparse.ArgumentParser, workers: int, out: str) -> None:
+    """--workers, --seed and --out of a study."""
     parser.add_argument("--workers", type=_positive_int("--workers"), default=workers)
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--out", type=Path, default=Path(out))
