@@ -29,6 +29,7 @@ class Observation:
     break_beams: np.ndarray = field(default_factory=lambda: np.zeros(0, bool))  # True where a beam is broken
     inclination: tuple | None = None  # (roll, pitch) in rad, for robots with an inclinometer
     effectors: dict = field(default_factory=dict)  # effector -> position in [0, 1] from its encoder
+    drive_effort: float | None = None  # mean share of the locomotion motors' force limit in use ("PWM effort")
 
 
 class TraceEvent(Protocol):

@@ -146,6 +146,22 @@ def _outputs(run_dir: Path) -> list[str]:
         return []
 
 
+def _run_without_physics(config: TrialConfig, mission) -> TrialResult:
+    """A mission's physics-free backend (``mission.run_without_physics(config, run_dir)`` returns its summary):
+    the same run folder and summary.json, and whatever figures the mission draws; no video or trajectory."""
+    if config.video.enabled:
+        raise ConfigError("--video: a physics-free run has nothing to render; allowed with the physics backend")
+    run_dir = make_run_dir(config)
+    started = time.perf_counter()
+    summary = mission.run_without_physics(config, run_dir)
+    wall = time.perf_counter() - started
+    summary.update(run_id=run_dir.name, wall_time_s=round(wall, 3), teamsim=teamsim.__version__,
+                   real_time_factor=round(summary["sim_time_s"] / wall, 2) if wall > 0 else None,
+                   faults=[f.describe() for f in config.faults], outputs=_outputs(run_dir) + ["summary.json"])
+    write_json(run_dir / "summary.json", summary)
+    return TrialResult(summary["status"], run_dir, summary)
+
+
 def run_trial(config: TrialConfig, seed: int | None = None, progress: bool | None = None) -> TrialResult:
     """Run one trial and write its outputs. ``seed`` overrides ``config.seed``. Bad configuration raises
     ConfigError before anything is written; everything after that ends in a saved summary."""
@@ -154,6 +170,8 @@ def run_trial(config: TrialConfig, seed: int | None = None, progress: bool | Non
     validate(config)
     mission = mission_of(config.mission)
     config = resolve(config, mission)  # the mission's world as a scenario, if it describes its worlds so
+    if getattr(mission, "without_physics", None) and mission.without_physics(config):
+        return _run_without_physics(config, mission)
     duration = config.duration or mission.default_duration
     world = World(config, mission)
     video = None
@@ -177,9 +195,13 @@ def run_trial(config: TrialConfig, seed: int | None = None, progress: bool | Non
     world.record_trace = motivation
     speedup = config.video.speedup or getattr(mission, "video_speedup", 1.0)
     recorder = TrajectoryRecorder(world.xml, list(world.robots), config.video.fps, world.physics_dt, speedup)
+    panel_of = None
     if config.video.enabled:
+        # A mission's optional ``video_panel(world)``: an RGB uint8 image shown beside the view at every video frame,
+        # or None to keep the last one; a new array when it changes, else the same one (teamsim.video.VideoProcess).
+        panel_of = getattr(mission, "video_panel", None)
         video = VideoProcess(run_dir / "video.mp4", world.xml, list(world.robots), config.video.width,
-                             config.video.height, config.video.camera, config.video.fps)
+                             config.video.height, config.video.camera, config.video.fps, panel=panel_of is not None)
     bar = Progress(duration, f"{config.mission} seed {config.seed}", enabled=progress)
     events({"t": 0.0, "event": "trial_start", "mission": config.mission, "seed": config.seed,
             "robots": list(world.robots)})
@@ -189,7 +211,7 @@ def run_trial(config: TrialConfig, seed: int | None = None, progress: bool | Non
                       for r in world.robots.values()]  # (a removed robot is out of the arena: absent)
         recorder.capture(world.time, world.data.qpos, behaviours)
         if video is not None:
-            video.write(world.time, world.data.qpos, behaviours)
+            video.write(world.time, world.data.qpos, behaviours, panel_of(world) if panel_of else None)
 
     status, error, completed, metrics = "running", None, False, {}
     failed_writes: list[str] = []

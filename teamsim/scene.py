@@ -29,3 +29,5 @@ class Scene:
     info: dict = field(default_factory=dict)  # whatever else the mission needs later (goal, known map, ...)
     faults: list = field(default_factory=list)  # teamsim.faults.Fault the scenario starts with (a dead sensor, ...)
     scenario: Any = None  # the teamsim.scenario.Scenario it was built from, if the mission describes worlds so
+    # Robot -> (bandwidth bit/s, range m): the team talks over teamsim.network (Chand's 802.11) instead of the radio
+    network: dict | None = None

@@ -6,6 +6,10 @@ same pixels. :class:`Mp4Writer` pipes each frame to ffmpeg (libx264, yuv420p, pl
 comes, so a video is never held in memory. During a run, :class:`VideoProcess` does both in a process of its
 own, fed the recorded frames through a queue, so rendering and encoding take the second core and the physics
 keeps the first.
+
+A mission may show an image of its own beside the view (its ``video_panel`` hook, see :class:`VideoProcess`):
+each frame is then [rendered view | panel], the panel scaled to the view's height (:class:`SidePanel`). A panel
+is not part of the trajectory, so ``teamsim render`` makes the view alone.
 """
 from __future__ import annotations
 
@@ -142,36 +146,108 @@ class Mp4Writer:
                 self._part.unlink(missing_ok=True)
 
 
+class SidePanel:
+    """A mission's image beside the rendered view, in a slot as high as the view. The first panel sets the slot's
+    width (scaled to the view's height, keeping its aspect ratio; one column more if needed for an even frame
+    width, which H.264 needs); a later panel of another shape is fitted inside the slot, centred on black, so a
+    run's frames all have one size. Until the first panel comes, the slot is a black square."""
+
+    def __init__(self, view_width: int, height: int):
+        self.view_width, self.height = view_width, height
+        self.width: int | None = None
+        self._image: np.ndarray | None = None
+
+    def update(self, image: np.ndarray) -> None:
+        """Show ``image`` (RGB, uint8, height x width x 3) from now on; scaled once here, not at every frame."""
+        if image.dtype != np.uint8 or image.ndim != 3 or image.shape[2] != 3 or 0 in image.shape:
+            raise ValueError(f"video_panel must return an RGB uint8 image (height x width x 3), "
+                             f"not {image.dtype} of shape {image.shape}")
+        if self.width is None:
+            self.width = self._even(round(image.shape[1] * self.height / image.shape[0]))
+        self._image = _fit(image, self.width, self.height)
+
+    def beside(self, view: np.ndarray) -> np.ndarray:
+        """The frame: ``view`` with the panel (or the black square before the first one) on its right."""
+        if self.width is None:
+            self.width = self._even(self.height)
+        panel = self._image if self._image is not None else np.zeros((self.height, self.width, 3), np.uint8)
+        return np.hstack([view, panel])
+
+    def _even(self, width: int) -> int:
+        """``width`` (at least 1), one more if the frame would otherwise be of odd width."""
+        width = max(1, width)
+        return width + (self.view_width + width) % 2
+
+
+def _fit(image: np.ndarray, width: int, height: int) -> np.ndarray:
+    """``image`` scaled to fit a black ``width`` x ``height`` box, keeping its aspect ratio, centred in it. Scaled
+    down by area (a large map stays readable), up by nearest neighbour (a map's cells stay sharp squares)."""
+    scale = min(width / image.shape[1], height / image.shape[0])
+    size = (min(width, max(1, round(image.shape[1] * scale))), min(height, max(1, round(image.shape[0] * scale))))
+    scaled = cv2.resize(image, size, interpolation=cv2.INTER_AREA if scale < 1 else cv2.INTER_NEAREST)
+    box = np.zeros((height, width, 3), np.uint8)
+    top, left = (height - size[1]) // 2, (width - size[0]) // 2
+    box[top:top + size[1], left:left + size[0]] = scaled
+    return box
+
+
 FRAME_QUEUE = 256  # frames waiting for the video process: a few hundred bytes of qpos each
+PANELS_IN_FLIGHT = 4  # panels sent but not yet taken by the video process: a 640x640 map is 1.2 MB each
 
 
 class VideoProcess:
     """A run's ``video.mp4``, rendered and encoded in a spawned process from the frames ``write`` hands it.
     The physics waits only when the queue is full. ``close`` finishes the file and returns None, or what went
-    wrong in the video process (the run's own outcome does not depend on it)."""
+    wrong in the video process (the run's own outcome does not depend on it).
+
+    With ``panel`` true, every frame has a side panel (:class:`SidePanel`) showing the last image ``write`` was
+    given. An image goes through the queue only when it is a new object: a mission whose panel has not changed
+    returns the same array (or None) and costs nothing, where pickling a 640x640 map 30 times a second would cost
+    37 MB/s. Comparing identity, not content, is what keeps it cheap, so a mission must return a new array when
+    its image changes, never redraw the one it returned before. At most ``PANELS_IN_FLIGHT`` images wait in the
+    queue at once (the physics waits for the video process beyond that), which bounds the memory they take."""
 
     def __init__(self, path: Path, model_xml: str, robot_names: list[str], width: int, height: int, camera: str,
-                 fps: int):
+                 fps: int, panel: bool = False):
         context = multiprocessing.get_context("spawn")  # a GL context does not survive a fork
         self._frames = context.Queue(maxsize=FRAME_QUEUE)
         self._failures = context.Queue()
+        self._panel_slots = context.BoundedSemaphore(PANELS_IN_FLIGHT)
+        self._panel: np.ndarray | None = None  # the last image sent; held, so its identity is never reused
+        self.panels_sent = 0
         self._process = context.Process(target=_render_frames, name="teamsim-video", daemon=True,
-                                        args=(self._frames, self._failures, Path(path), model_xml,
-                                              list(robot_names), width, height, camera, fps))
+                                        args=(self._frames, self._failures, self._panel_slots, Path(path), model_xml,
+                                              list(robot_names), width, height, camera, fps, panel))
         self._process.start()
 
-    def write(self, time: float, qpos: np.ndarray, behaviours: list[str]) -> None:
-        self._put((time, np.array(qpos), list(behaviours)))
+    def write(self, time: float, qpos: np.ndarray, behaviours: list[str], panel: np.ndarray | None = None) -> None:
+        """Queue a frame; ``panel`` is the side panel's image for it, None to keep the previous one."""
+        if panel is self._panel:
+            panel = None
+        if panel is not None:
+            self._panel = panel
+            panel = np.array(panel)  # a copy: the queue pickles it later, in a thread of its own
+            if not self._wait(self._panel_slots.acquire):
+                return
+            self.panels_sent += 1
+        self._put((time, np.array(qpos), list(behaviours), panel))
+
+    def _wait(self, acquire) -> bool:
+        """Call ``acquire(timeout=...)`` until it succeeds (True) or the video process has ended (False)."""
+        while self._process.is_alive():
+            if acquire(timeout=0.5):
+                return True
+        return False
 
     def _put(self, item) -> bool:
         """Queue ``item``; False if the video process has ended."""
-        while self._process.is_alive():
+        def put(timeout: float) -> bool:
             try:
-                self._frames.put(item, timeout=0.5)
+                self._frames.put(item, timeout=timeout)
                 return True
             except queue.Full:
-                continue
-        return False
+                return False
+        return self._wait(put)
 
     def close(self) -> str | None:
         self._put(None)
@@ -184,20 +260,29 @@ class VideoProcess:
             return f"the video process ended with exit code {self._process.exitcode}"
 
 
-def _render_frames(frames, failures, path: Path, model_xml: str, robot_names: list[str], width: int, height: int,
-                   camera: str, fps: int) -> None:
+def _render_frames(frames, failures, panel_slots, path: Path, model_xml: str, robot_names: list[str], width: int,
+                   height: int, camera: str, fps: int, panel: bool) -> None:
     """The video process: render and encode every frame until the end marker (None). It ignores Ctrl-C, which
     reaches the whole process group: the run, interrupted, still sends the end marker, so the video keeps
-    every frame up to the interruption."""
+    every frame up to the interruption. The mp4 is opened at the first frame, whose size the panel may set."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     try:
         renderer = FrameRenderer(model_xml, robot_names, width, height, camera)
-        writer = Mp4Writer(path, width, height, fps)
+        side = SidePanel(width, height) if panel else None
+        writer = None
         try:
-            while (frame := frames.get()) is not None:
-                writer.write(renderer.render(*frame))
+            while (item := frames.get()) is not None:
+                *state, image = item
+                if image is not None:
+                    panel_slots.release()
+                    side.update(image)
+                frame = renderer.render(*state)
+                frame = side.beside(frame) if side else frame
+                writer = writer or Mp4Writer(path, frame.shape[1], frame.shape[0], fps)
+                writer.write(frame)
         finally:
-            writer.close()
+            if writer is not None:
+                writer.close()
             renderer.close()
     except BaseException as exc:  # noqa: BLE001  (reported to the run, which writes it in the summary)
         failures.put(f"{type(exc).__name__}: {exc}")

@@ -25,6 +25,7 @@ from teamsim.controllers.skills.locomotion import make_locomotion
 from teamsim.faults import Fault, Health, apply_fault
 from teamsim.models import ROBOT_BUILDERS, build_robot
 from teamsim.models.robot import RobotModel
+from teamsim.network import Delivery, Network, NetworkConfig
 from teamsim.positioning import PositioningService, wrap_angle
 from teamsim.radio import RadioBus
 from teamsim.rng import RandomStreams
@@ -93,6 +94,14 @@ def yaw_of(quat: np.ndarray) -> float:
     return math.atan2(2 * (w * z + x * y), 1 - 2 * (y * y + z * z))
 
 
+def _radio_event(now: float, message) -> dict:
+    """The event a sent radio message or network packet is logged as; a packet's payload (a map array) is not."""
+    if isinstance(message, Delivery):
+        return {"t": round(now, 6), "event": "net", "robot": message.sender, "to": message.to,
+                "kind": message.kind, "bytes": message.size}
+    return {"t": round(now, 6), "event": "radio", "robot": message.sender, "payload": message.payload}
+
+
 class World:
     def __init__(self, config: TrialConfig, mission, events=None):
         self.config = config
@@ -146,7 +155,9 @@ class World:
         self.data = mujoco.MjData(self.model)
         self.model.opt.disableflags |= _SENSOR_STAGE
         self._index_model()
-        self.radio = RadioBus(config.radio, {n: self.streams.get("robot", n, "radio") for n in self.robots})
+        radio_rngs = {n: self.streams.get("robot", n, "radio") for n in self.robots}
+        self.radio = (Network(NetworkConfig(), scene.network, radio_rngs) if scene.network is not None
+                      else RadioBus(config.radio, radio_rngs))
         self.positioning = PositioningService(config.positioning,
                                               {n: self.streams.get("robot", n, "positioning") for n in self.robots})
         for robot in self.robots.values():
@@ -262,7 +273,7 @@ class World:
         poses = {r.name: self.pose(r) for r in live}
         self.positioning.update(now, poses, {r.name: self.speed(r) for r in live})
         for message in self.radio.update(now, poses):
-            self.record({"t": round(now, 6), "event": "radio", "robot": message.sender, "payload": message.payload})
+            self.record(_radio_event(now, message))
         for k in self._robots_touching():
             self._touching_s[k] += self.control_dt
         touch = self._touch_forces()
@@ -298,7 +309,8 @@ class World:
             motor_speeds=d.qvel[robot.motor_dofs], velocity=self.read_odometry(robot, now), touch=touch,
             break_beams=(beams >= 0) & (beams < spec.beam_length),
             inclination=self.inclination(robot) if spec.inclinometer else None,
-            effectors={name: self._effector_position(robot, name) for name in robot.effectors})
+            effectors={name: self._effector_position(robot, name) for name in robot.effectors},
+            drive_effort=self._drive_effort(robot))
         command: Command = robot.controller(observation)
         if not (math.isfinite(command.v) and math.isfinite(command.omega)):
             raise ValueError(f"controller of {robot.name} returned a non-finite command {command}")
@@ -332,6 +344,12 @@ class World:
         setpoint = min(max(float(setpoint), 0.0), 1.0)
         span = effector.ctrl_at_1 - effector.ctrl_at_0
         self.data.ctrl[robot.effectors[name][0]] = effector.ctrl_at_0 + setpoint * span
+
+    def _drive_effort(self, robot: Robot) -> float:
+        """Mean |force| / force limit of the locomotion motors: the PWM effort a motor driver would show."""
+        limit = self.model.actuator_forcerange[robot.actuators, 1]
+        force = np.abs(self.data.actuator_force[robot.actuators])
+        return float(np.mean(np.where(limit > 0, force / np.where(limit > 0, limit, 1.0), 0.0)))
 
     def _effector_position(self, robot: Robot, name: str) -> float:
         """The effector's encoder reading, on the same [0, 1] scale as its command."""

@@ -17,7 +17,8 @@ PACKAGE_DIRS = {"teamsim": "teamsim", "teamsim.models": "models", "teamsim.contr
                 "teamsim.tasks": "tasks"}
 
 FOUNDATION = ("teamsim", "teamsim.config", "teamsim.rng", "teamsim.files", "teamsim.gl", "teamsim.progress",
-              "teamsim.stats", "teamsim.plots", "teamsim.positioning", "teamsim.radio", "teamsim.faults")
+              "teamsim.stats", "teamsim.plots", "teamsim.positioning", "teamsim.radio", "teamsim.network",
+              "teamsim.faults")
 RUNTIME = ("teamsim.world", "teamsim.runner", "teamsim.recording", "teamsim.timeline", "teamsim.video",
            "teamsim.rerender", "teamsim.sweep")
 LAYER_OF = {  # module or package (its modules too; "teamsim" alone) -> layer; the longest prefix wins

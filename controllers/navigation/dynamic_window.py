@@ -682,6 +682,7 @@ class DynamicWindowController:
         self.previous_direction: float | None = None  # last theta_tmod, world frame
         self.arrived = False
         self.trail: list[tuple[float, float, float]] = []  # (time, x, y) of every pose estimate, for the outcome
+        self.pose_estimate: tuple[float, float, float] | None = None  # the last fix advanced by odometry
         self.escape = TrapEscape(self.goal, footprint_radius) if self.escapes_traps else None
 
     @property
@@ -693,7 +694,7 @@ class DynamicWindowController:
         if len(contact):
             self.state = DriveState(obs.velocity[0], obs.velocity[1], self.state.steer)
         v, omega = (self.state.v, self.state.omega) if obs.velocity is None else obs.velocity
-        pose = self.tracker.update(obs.time, obs.pose, v, omega)
+        pose = self.pose_estimate = self.tracker.update(obs.time, obs.pose, v, omega)
         seen = self._seen(obs, contact)
         points = self._remember(obs.time, seen)
         if pose is None:
@@ -829,6 +830,14 @@ class HRDK(FRC):
             self.plan(centre)
         return self.follower.waypoint(centre, self.goal)
 
+    def retarget(self, goal: tuple[float, float], path: np.ndarray | None = None) -> None:
+        """Drive on to a new ``goal``: along ``path`` ((n, 2) world points, e.g. a planner's) if given, else along
+        a plan of its own made at the next decision. The obstacle memory is kept."""
+        self.goal = (float(goal[0]), float(goal[1]))
+        self.arrived = False
+        self.follower = None if path is None else PathFollower(np.asarray(path, float), True, self.grid.resolution,
+                                                                self.following)
+
 
 @dataclass(frozen=True)
 class Replanning:
@@ -859,6 +868,10 @@ class HRDU(HRDK):
     def name(self) -> str:
         return "hrdu"
 
+    def retarget(self, goal: tuple[float, float], path: np.ndarray | None = None) -> None:
+        super().retarget(goal, path)
+        self.progress_check = None
+
     def waypoint(self, pose, centre, obs):
         self.grid.update(pose, obs.ir_range, obs.ir_bearings, sensor_radius=self.sensor_radius,
                          centre_offset=self.offset, footprint_radius=self.radius)
@@ -868,6 +881,8 @@ class HRDU(HRDK):
             self.last_plan_time = obs.time
             self.progress_check = (obs.time, distance)
             return super().waypoint(pose, centre, obs)
+        if self.progress_check is None:  # following a path handed over by ``retarget``
+            self.progress_check = (obs.time, distance)
         replan = self.path_blocked()
         if obs.time - self.progress_check[0] >= self.replanning.progress_period:
             progress = self.progress_check[1] - distance

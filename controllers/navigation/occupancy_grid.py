@@ -128,7 +128,7 @@ class OccupancyGrid:
         ux, uy = np.cos(directions), np.sin(directions)
         sx, sy = cx + sensor_radius * ux, cy + sensor_radius * uy
         reach = float(np.max(sensor_radius)) + p.range_max + self.resolution
-        rows, cols = self._window(cx, cy, reach)
+        rows, cols = self.window(cx, cy, reach)
         if rows.size == 0 or cols.size == 0:
             return
         wx, wy = self.cell_to_world(rows[:, None], cols[None, :])  # (R, C) cell centres
@@ -155,7 +155,7 @@ class OccupancyGrid:
         posterior = 1.0 / (1.0 + np.exp(-(_logit(self.probabilities[block]) + evidence)))
         self.probabilities[block] = np.clip(posterior, p.p_min, p.p_max)
 
-    def _window(self, x: float, y: float, reach: float) -> tuple[np.ndarray, np.ndarray]:
+    def window(self, x: float, y: float, reach: float) -> tuple[np.ndarray, np.ndarray]:
         """Row and column indices of the grid cells within ``reach`` (a square) of (x, y)."""
         row_lo, col_lo = self.world_to_cell(x - reach, y - reach)
         row_hi, col_hi = self.world_to_cell(x + reach, y + reach)

@@ -291,12 +291,72 @@ class KinematicRun:
     pose: tuple[float, float, float] = (0.0, 0.0, 0.0)  # where the run ended
 
 
+class KinematicBody:
+    """One robot's pose and drive in a physics-free world: ideal IR ranges, and motion from the slewed command.
+
+    The command is clipped and slewed by the drive limits as the locomotion does; a tricycle's front wheel turns as
+    the locomotion turns it (``locomotion.next_steer``) and the robot then follows the bicycle model, a
+    differential drive the unicycle model. ``speed_scale`` slows the motion (a bog: the robot's traversability)."""
+
+    def __init__(self, robot: KinematicRobot, pose: tuple[float, float, float], control_dt: float = 0.1,
+                 substeps: int = 5):
+        self.robot = robot
+        self.x, self.y, self.heading = pose
+        self.steer = 0.0
+        self.control_dt, self.substeps = control_dt, substeps
+        self.slew = SlewLimiter(robot.limits, control_dt)
+        self.bearings = 2 * np.pi * np.arange(robot.ir_count) / robot.ir_count
+        self.sensor_radius = np.asarray(robot.sensor_radius or (robot.radius,) * robot.ir_count, float)
+        self.velocity = (0.0, 0.0)  # odometry of the last tick's motion
+
+    def centre(self, x: float, y: float, heading: float) -> tuple[float, float]:
+        offset = self.robot.centre_offset
+        return x + offset * math.cos(heading), y + offset * math.sin(heading)
+
+    def ranges(self, world: NavWorld) -> np.ndarray:
+        cx, cy = self.centre(self.x, self.y, self.heading)
+        directions = np.column_stack([np.cos(self.heading + self.bearings), np.sin(self.heading + self.bearings)])
+        return ray_ranges(world, np.array([cx, cy]) + self.sensor_radius[:, None] * directions, directions,
+                          self.robot.ir_range)
+
+    def motion(self, command, speed_scale: float = 1.0) -> tuple[float, float, float, tuple[float, float]]:
+        """Where this tick's command would take the robot, and the odometry it would read."""
+        robot = self.robot
+        v, omega = self.slew(command.v, command.omega)
+        turn_rate = omega
+        if robot.kind == "tricycle":
+            self.steer = next_steer(self.steer, v, omega, (command.v, command.omega), robot, self.control_dt)
+            turn_rate = v * math.tan(self.steer) / robot.wheelbase
+        v, turn_rate = v * speed_scale, turn_rate * speed_scale
+        dt = self.control_dt / self.substeps
+        nx, ny, nheading = self.x, self.y, self.heading
+        for _ in range(self.substeps):
+            nx += v * dt * math.cos(nheading)
+            ny += v * dt * math.sin(nheading)
+            nheading += turn_rate * dt
+        nheading = (nheading + math.pi) % (2 * math.pi) - math.pi
+        return nx, ny, nheading, (v, turn_rate)
+
+    def gap(self, world: NavWorld, x: float, y: float, heading: float) -> float:
+        """Clearance between the enclosing circle at that pose and the nearest box or wall."""
+        return clearance(world, *self.centre(x, y, heading)) - self.robot.radius
+
+    def move(self, x: float, y: float, heading: float, velocity: tuple[float, float]) -> float:
+        """Take the pose; the distance moved."""
+        moved = math.hypot(x - self.x, y - self.y)
+        self.x, self.y, self.heading, self.velocity = x, y, heading, velocity
+        return moved
+
+    def halt(self) -> None:
+        """A refused motion: the drive stops."""
+        self.slew.reset()
+        self.velocity = (0.0, 0.0)
+
+
 def kinematic_run(world: NavWorld, controller, robot: KinematicRobot, duration: float,
                   control_dt: float = 0.1, substeps: int = 5, on_contact: str = "end") -> KinematicRun:
-    """Drive ``controller`` from the world's start with ideal IR ranges and exact positioning fixes every control
-    tick. The command is clipped and slewed by the drive limits as the locomotion does; a tricycle's front wheel
-    turns as the locomotion turns it (``locomotion.next_steer``) and the robot then follows the bicycle model, a
-    differential drive follows the unicycle model.
+    """Drive ``controller`` (through a ``KinematicBody``) from the world's start with ideal IR ranges and exact
+    positioning fixes every control tick.
 
     ``on_contact`` says what a motion that would make the enclosing circle touch a box or wall does: "end" ends
     the run there as a collision; "stop" refuses that tick's motion and halts the robot (v = omega = 0), the way a
@@ -304,56 +364,34 @@ def kinematic_run(world: NavWorld, controller, robot: KinematicRobot, duration: 
     odometry of the last tick's motion (``Observation.velocity``): zero after a halt."""
     if on_contact not in ("end", "stop"):
         raise ValueError(f"on_contact={on_contact!r}: allowed: end, stop")
-    slew = SlewLimiter(robot.limits, control_dt)
-    x, y, heading = world.start
-    steer = 0.0
-    bearings = 2 * np.pi * np.arange(robot.ir_count) / robot.ir_count
-    sensor_radius = np.asarray(robot.sensor_radius or (robot.radius,) * robot.ir_count, float)
+    body = KinematicBody(robot, world.start, control_dt, substeps)
     decision_times = []
     min_clearance = math.inf
     travelled, touches = 0.0, 0
-    velocity = (0.0, 0.0)
     steps = round(duration / control_dt)
 
     def run(reached: bool, collided: bool, time_end: float) -> KinematicRun:
         return KinematicRun(reached, collided, time_end, min_clearance, np.array(decision_times), travelled,
-                            touches, (x, y, heading))
+                            touches, (body.x, body.y, body.heading))
 
     for tick in range(steps):
         time_now = tick * control_dt
-        cx, cy = x + robot.centre_offset * math.cos(heading), y + robot.centre_offset * math.sin(heading)
-        directions = np.column_stack([np.cos(heading + bearings), np.sin(heading + bearings)])
-        ranges = ray_ranges(world, np.array([cx, cy]) + sensor_radius[:, None] * directions, directions,
-                            robot.ir_range)
+        ranges = body.ranges(world)
         observation = Observation(time=time_now, robot="kinematic", ir_raw=ranges, ir_range=ranges,
-                                  ir_bearings=bearings, pose=PoseFix(x, y, heading, time_now), velocity=velocity)
+                                  ir_bearings=body.bearings, pose=PoseFix(body.x, body.y, body.heading, time_now),
+                                  velocity=body.velocity)
         began = time_module.perf_counter()
         command = controller(observation)
         decision_times.append(time_module.perf_counter() - began)
         if command.behaviour == "arrived":
             return run(True, False, time_now)
-        v, omega = slew(command.v, command.omega)
-        turn_rate = omega
-        if robot.kind == "tricycle":
-            steer = next_steer(steer, v, omega, (command.v, command.omega), robot, control_dt)
-            turn_rate = v * math.tan(steer) / robot.wheelbase
-        dt = control_dt / substeps
-        nx, ny, nheading = x, y, heading
-        for _ in range(substeps):
-            nx += v * dt * math.cos(nheading)
-            ny += v * dt * math.sin(nheading)
-            nheading += turn_rate * dt
-        nheading = (nheading + math.pi) % (2 * math.pi) - math.pi
-        cx, cy = nx + robot.centre_offset * math.cos(nheading), ny + robot.centre_offset * math.sin(nheading)
-        gap = clearance(world, cx, cy) - robot.radius
+        nx, ny, nheading, velocity = body.motion(command)
+        gap = body.gap(world, nx, ny, nheading)
         if gap < 0 and on_contact == "stop":
             touches += 1
-            slew.reset()
-            velocity = (0.0, 0.0)
+            body.halt()
             continue
-        travelled += math.hypot(nx - x, ny - y)
-        x, y, heading = nx, ny, nheading
-        velocity = (v, turn_rate)
+        travelled += body.move(nx, ny, nheading, velocity)
         min_clearance = min(min_clearance, gap)
         if gap < 0:
             return run(False, True, time_now + control_dt)

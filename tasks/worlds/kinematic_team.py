@@ -1,0 +1,127 @@
+"""A team without physics: the explore mission's kinematic backend, as Chand's own MATLAB simulations ran (§8.2).
+
+Each robot is a ``KinematicBody`` in the world's boxes (ideal IR ranges, exact positioning fixes every tick), its
+controller the same as in physics, its messages on the same ``teamsim.network``. A motion that would touch a box,
+a wall or another robot is refused and the robot halted, as a bumper stops it. Terrain (docs/decisions.md,
+"Exploration"): in a bog a robot moves at its traversability times the commanded speed, the physics bog's top
+speed; the drive effort a controller reads is the share of the motors' force the motion needs, ``FIRM_EFFORT`` of
+full effort per unit of speed on firm ground and 1 / traversability in a bog, capped at 1. Faults: kill and remove
+(the robot stops and falls silent), radio-off, break-motor (it cannot move), slow.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Callable
+
+import numpy as np
+
+from teamsim.config import ConfigError
+from teamsim.controllers.base import Observation
+from teamsim.faults import Fault
+from teamsim.network import Network
+from teamsim.positioning import PoseFix
+from teamsim.tasks.worlds.navigation import KinematicBody, NavWorld
+
+FIRM_EFFORT = 0.3  # share of full effort to hold top speed on firm ground (rolling resistance; assumed)
+KINEMATIC_FAULTS = ("kill", "remove", "radio-off", "break-motor", "slow")
+
+
+@dataclass
+class Member:
+    body: KinematicBody
+    controller: Callable[[Observation], object]
+    traversability: float
+    alive: bool = True
+    speed_factor: float = 1.0
+    effort: float = 0.0
+    behaviour: str = "idle"
+    travelled: float = 0.0
+    touches: int = 0
+    trail: list = field(default_factory=list)  # (time, x, y)
+
+
+class KinematicTeam:
+    def __init__(self, world: NavWorld, bogs, members: dict[str, Member], network: Network,
+                 faults: list[Fault] = (), control_dt: float = 0.1):
+        self.world = world
+        self.bogs = list(bogs)
+        self.members = members
+        self.network = network
+        self.control_dt = control_dt
+        for fault in faults:
+            if fault.kind not in KINEMATIC_FAULTS:
+                raise ConfigError(f"--fault {fault.kind}: the kinematic backend has {', '.join(KINEMATIC_FAULTS)}")
+            if fault.robot not in members:
+                raise ConfigError(f"--fault {fault.kind}:{fault.robot}: no robot {fault.robot!r} in the team; "
+                                  f"allowed: {', '.join(members)}")
+        self.faults = sorted(faults, key=lambda f: f.time)
+        self.time = 0.0
+        self.events: list[dict] = []
+
+    def in_bog(self, x: float, y: float) -> bool:
+        return any(abs(x - b.x) <= b.half_x and abs(y - b.y) <= b.half_y for b in self.bogs)
+
+    def tick(self) -> None:
+        """Faults due, the network, then every live robot senses, decides and moves."""
+        now = self.time
+        while self.faults and self.faults[0].time <= now + 1e-9:
+            self._apply(self.faults.pop(0))
+        live = {name: m for name, m in self.members.items() if m.alive}
+        self.network.update(now, {name: np.array([m.body.x, m.body.y]) for name, m in live.items()})
+        for name, member in live.items():
+            self._control(name, member, now)
+        self.time = round(now + self.control_dt, 9)
+
+    def _control(self, name: str, member: Member, now: float) -> None:
+        body = member.body
+        ranges = body.ranges(self.world)
+        observation = Observation(time=now, robot=name, ir_raw=ranges, ir_range=ranges, ir_bearings=body.bearings,
+                                  pose=PoseFix(body.x, body.y, body.heading, now),
+                                  inbox=tuple(self.network.take_inbox(name)),
+                                  robots_present=self.network.robots_present(name, now), velocity=body.velocity,
+                                  drive_effort=member.effort)
+        command = member.controller(observation)
+        self.network.set_outbox(name, command.broadcast)
+        if command.behaviour != member.behaviour:
+            self.events.append({"t": round(now, 6), "event": "behaviour", "robot": name,
+                                "from": member.behaviour, "to": command.behaviour})
+            member.behaviour = command.behaviour
+        bogged = self.in_bog(*body.centre(body.x, body.y, body.heading))
+        terrain = member.traversability if bogged else 1.0
+        x, y, heading, velocity = body.motion(command, terrain * member.speed_factor)
+        v_max = body.robot.limits.v_max
+        member.effort = min(1.0, abs(body.slew.v) / v_max * (1.0 / max(member.traversability, 1e-3) if bogged
+                                                              else FIRM_EFFORT))
+        if body.gap(self.world, x, y, heading) < 0 or self._bumps(name, body, x, y, heading):
+            member.touches += 1
+            body.halt()
+            return
+        member.travelled += body.move(x, y, heading, velocity)
+        member.trail.append((now, body.x, body.y))
+
+    def _bumps(self, name: str, body: KinematicBody, x: float, y: float, heading: float) -> bool:
+        """The move would bring its enclosing circle closer into another live robot's."""
+        after = body.centre(x, y, heading)
+        before = body.centre(body.x, body.y, body.heading)
+        for other, member in self.members.items():
+            if other == name or not member.alive:
+                continue
+            them = member.body.centre(member.body.x, member.body.y, member.body.heading)
+            reach = body.robot.radius + member.body.robot.radius
+            if math.dist(after, them) < reach and math.dist(after, them) < math.dist(before, them):
+                return True
+        return False
+
+    def _apply(self, fault: Fault) -> None:
+        member = self.members[fault.robot]
+        if fault.kind in ("kill", "remove"):
+            member.alive = False
+            self.network.set_enabled(fault.robot, False)
+        elif fault.kind == "radio-off":
+            self.network.set_enabled(fault.robot, False)
+        elif fault.kind == "break-motor":
+            member.speed_factor = 0.0
+        elif fault.kind == "slow":
+            member.speed_factor = float(fault.options.get("factor", 0.5))
+        self.events.append({"t": round(self.time, 6), "event": "fault", **fault.describe()})
