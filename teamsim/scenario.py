@@ -675,6 +675,8 @@ def config_of(scenario: Scenario, mission, like: TrialConfig, extra_faults: list
     scenario's own and the output settings (out, run id, video) of ``like``. The config holds the seed, the
     duration, timing, radio, positioning and the faults; its ``scenario`` holds the world (faults emptied)."""
     faults = [_fault(k, entry) for k, entry in enumerate(scenario.faults)] + list(extra_faults)
+    if hasattr(mission, "fault_targets"):  # a mission may let faults name robots by role ("kill:planner@60")
+        faults = mission.fault_targets(scenario, faults)
     check(scenario, faults)
     extra_check = getattr(mission, "check_scenario", None)
     if extra_check is not None:

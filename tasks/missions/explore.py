@@ -40,7 +40,7 @@ from teamsim.models import build_robot
 from teamsim.models.robot import RobotModel, TricycleSpec
 from teamsim.network import Network, NetworkConfig
 from teamsim.rng import RandomStreams
-from teamsim.scenario import Arena, BogZone, BoxObstacle, RobotEntry, Scenario, scene_of
+from teamsim.scenario import Arena, BogZone, BoxObstacle, RobotEntry, Scenario, resolve, scene_of
 from teamsim.scene import Scene
 from teamsim.tasks.base import ScenarioMission
 from teamsim.tasks.missions.explore_figures import panel_image, write_coverage, write_map
@@ -224,6 +224,12 @@ class ExploreMission(ScenarioMission):
     def write_outputs(self, world, run_dir: Path) -> None:
         write_figures(world.scene.info, run_dir)
 
+    def fault_targets(self, scenario: Scenario, faults: list) -> list:
+        """Faults may name a robot by its role: manager, feedback, planner, explorer, plannerN, explorerN."""
+        task = scenario.task
+        return fault_targets(faults, team_allocation(list(scenario.robots), task.planners, task.explorers),
+                             list(scenario.robots))
+
     def video_panel(self, world) -> np.ndarray | None:
         """The manager's global map as it grows, beside the top-down view: redrawn every ``PANEL_PERIOD`` s."""
         info = world.scene.info
@@ -249,6 +255,29 @@ class ExploreMission(ScenarioMission):
 
     def outcome(self, world) -> tuple[bool, dict]:
         return exploration_outcome(world.scene.info, world.time)
+
+
+def role_names(allocation: Allocation) -> dict[str, str]:
+    """The names a fault may give a robot by: manager (M1), feedback (M2), planner and explorer (the first
+    explorer that is not also a planner), planner1.., explorer1.. in allocation order."""
+    planners, explorers = allocation.workers[PLANNER], allocation.workers[EXPLORER]
+    names = {"manager": allocation.managers["M1"], "feedback": allocation.managers["M2"],
+             "planner": planners[0], "explorer": next((r for r in explorers if r not in planners), explorers[0])}
+    names |= {f"planner{k}": r for k, r in enumerate(planners, 1)}
+    names |= {f"explorer{k}": r for k, r in enumerate(explorers, 1)}
+    return names
+
+
+def fault_targets(faults, allocation: Allocation, robots: list[str]) -> list:
+    """Faults with role names replaced by the robot holding the role; a name that is neither is an error."""
+    names = role_names(allocation)
+    out = []
+    for fault in faults:
+        if fault.robot not in robots and fault.robot not in names:
+            raise ConfigError(f"--fault {fault.kind}:{fault.robot}@{fault.time:g}: no robot or role "
+                              f"{fault.robot!r}; robots: {', '.join(robots)}; roles: {', '.join(names)}")
+        out.append(dataclasses.replace(fault, robot=names.get(fault.robot, fault.robot)))
+    return out
 
 
 def team_members(allocation: Allocation) -> set[str]:
@@ -419,10 +448,8 @@ def kinematic_team(scenario: Scenario, seed: int, faults=()) -> tuple[KinematicT
 def kinematic_trial(config, duration: float | None = None) -> dict:
     """An explore trial without physics: the same scenario (from the same seed), controllers and measures.
     Returns a summary shaped like ``run_trial``'s, with the team for the figures under ``"team"``."""
-    mission = ExploreMission()
-    scenario = config.scenario or mission.scenario(config.params, RandomStreams(config.seed).get("mission", "layout"),
-                                                   [])
-    mission.check_scenario(scenario)
+    config = resolve(config, ExploreMission())
+    scenario = config.scenario
     team, info = kinematic_team(scenario, config.seed, config.faults)
     duration = min(duration or config.duration or math.inf, team_duration(scenario.task.explorers))
     while team.time < duration - 1e-9 and not exploration_over(info):

@@ -1,0 +1,141 @@
+"""End to end: Chand's exploration (ch.6) with fixed seeds, in the kinematic backend on a small world (four local
+environments, 19.2 m: the same controllers and measures as the 38.4 m world, in seconds), and once in physics.
+
+What they check: the allocation makes the roles (§8.2's team from Table 5.22); the team explores the world and
+its map matches the true one; a wheeled explorer that drives into a bog reports it and backs out, and a tracked one
+maps it; a killed explorer is found by feedback within 2 T_m and its environment handed back; a killed planner's
+work passes to another robot; a broken motor is a partial failure; and bad input is one line and exit status 2.
+"""
+from __future__ import annotations
+
+import functools
+
+import pytest
+
+from teamsim.cli import main
+from teamsim.config import ConfigError, TrialConfig
+from teamsim.faults import parse_fault
+from teamsim.runner import run_trial
+from teamsim.tasks.missions.explore import ExploreParams, kinematic_trial, role_names, team_allocation
+
+SMALL = dict(size=19.2, divisions=2, t_m=30.0)  # four 9.6 m environments; feedback every 30 s
+
+
+@functools.cache
+def small_run(team: str = "1 2", seed: int = 2, bog_share: float = 0.0, faults: tuple[str, ...] = ()) -> dict:
+    params = ExploreParams(team=team, bog_share=bog_share, **SMALL)
+    config = TrialConfig(mission="explore", params=params, seed=seed, faults=[parse_fault(f) for f in faults])
+    return kinematic_trial(config)
+
+
+def events(run: dict, kind: str) -> list[dict]:
+    return [e for e in run["metrics"]["log"] if e["event"] == kind]
+
+
+# -- roles --------------------------------------------------------------------------------------------------------
+def test_the_allocation_staffs_the_thesis_teams_from_table_5_22():
+    """§8.2 ([RECON] from Table 5.27): managers on the PC-class robots, Robot4 plans and explores."""
+    allocation = team_allocation([f"Robot{k}" for k in range(1, 9)], 1, 5)
+    assert allocation.managers == {"M1": "Robot3", "M2": "Robot1"}
+    assert allocation.workers["W1"] == ["Robot4"]
+    assert allocation.workers["W2"][0] == "Robot4" and len(allocation.workers["W2"]) == 5
+    names = role_names(allocation)
+    assert names["planner"] == "Robot4" and names["explorer"] == allocation.workers["W2"][1]
+
+
+# -- the small world, kinematic -----------------------------------------------------------------------------------
+def test_a_team_explores_the_world_and_maps_it_right():
+    run = small_run()
+    metrics = run["metrics"]
+    assert run["status"] == "completed"
+    assert metrics["status"]["E"] + metrics["status"]["PE"] == 4 and metrics["status"]["UE"] == 0
+    assert metrics["explored_share"] >= 0.94  # the thesis's combined-feedback floor
+    assert metrics["map_accuracy"] >= 0.90
+    explored = {e["environment"] for e in events(run, "explored")}
+    assert explored == {0, 1, 2, 3}
+
+
+def test_same_seed_same_run():
+    a = small_run()["metrics"]
+    params = ExploreParams(team="1 2", bog_share=0.0, **SMALL)
+    b = kinematic_trial(TrialConfig(mission="explore", params=params, seed=2))["metrics"]
+    for key in ("exploration_time", "explored_share", "map_accuracy", "explored_cells", "log"):
+        assert a[key] == b[key], key
+
+
+def test_a_killed_explorer_is_found_within_two_feedback_periods_and_its_environment_handed_back():
+    run = small_run(faults=("kill:explorer@100",))
+    removed = events(run, "explorer removed")
+    assert len(removed) == 1 and 100 < removed[0]["t"] <= 100 + 2 * SMALL["t_m"]
+    flags = run["metrics"]["feedback_flags"]
+    assert [f["flag"] for f in flags if f["robot"] == removed[0]["robot"]] == ["CF"]
+    released = [e for e in events(run, "released") if e["robot"] == removed[0]["robot"]]
+    assert released and released[0]["t"] == removed[0]["t"]
+    assert run["metrics"]["explored_share"] >= 0.9
+
+
+def test_a_killed_planner_s_work_passes_to_another_robot():
+    run = small_run(faults=("kill:planner@60",))
+    removed = events(run, "planner removed")
+    assert len(removed) == 1 and removed[0]["t"] <= 60 + 2 * SMALL["t_m"]
+    later = [e for e in events(run, "assigned") if e["t"] > removed[0]["t"]]
+    assert later and all(e["planner"] != removed[0]["robot"] for e in later)
+    assert run["status"] == "completed"
+
+
+def test_a_broken_motor_is_a_partial_failure():
+    run = small_run(faults=("break-motor:explorer@60",))
+    flags = [f for f in run["metrics"]["feedback_flags"] if f["flag"] == "PF"]
+    assert flags and flags[0]["t"] <= 60 + 3 * SMALL["t_m"]
+    assert events(run, "explorer removed")[0]["robot"] == flags[0]["robot"]
+
+
+def test_a_wheeled_explorer_backs_out_of_a_bog_and_a_tracked_one_maps_it():
+    """Seed 6: tricycle Robot2 drives into the bog of environment 0, reports it, backs out and gives the
+    environment up; the tracked Robot4 (traversability 1) is later sent there and explores it."""
+    run = small_run(team="1 3", seed=6, bog_share=0.05)
+    bog, = events(run, "bog")
+    assert bog["robot"] == "Robot2" and bog["environment"] in run["metrics"]["boggy_environments"]
+    backing = [e for e in run["team"].events if e["event"] == "behaviour" and e["to"] == "explorer: back out of bog"]
+    assert backing and backing[0]["robot"] == "Robot2" and backing[0]["t"] == pytest.approx(bog["t"], abs=0.5)
+    given_up = [e for e in events(run, "released") if e["robot"] == "Robot2"]
+    assert given_up and given_up[0]["environment"] == bog["environment"] and given_up[0]["t"] > bog["t"]
+    explored = {e["environment"]: e["robot"] for e in events(run, "explored")}
+    assert explored.get(bog["environment"]) == "Robot4"
+
+
+# -- bad input ----------------------------------------------------------------------------------------------------
+@pytest.mark.parametrize("argv, fragment", [
+    (["--set", "team=3"], "team='3': write it [planners explorers]"),
+    (["--set", "team=1 9"], "can be explorers, the team asks for 9"),
+    (["--set", "robots=Robot2,Robot4,Robot5"], "no robot among Robot2, Robot4, Robot5 can take management task M1"),
+    (["--set", "robots=Robot9"], "robots='Robot9': allowed: Table 5.22's"),
+    (["--set", "size=10"], "too small for divisions 4"),
+    (["--set", "density=0.2"], "density=0.2: must be in [0, 0.15]"),
+    (["--fault", "kill:pilot@60"], "no robot or role 'pilot'; robots: Robot1"),
+    (["--set", "backend=kinematic", "--video"], "--video: a physics-free run has nothing to render"),
+])
+def test_bad_input_is_one_line_and_exit_2(capsys, tmp_path, argv, fragment):
+    code = main(["run", "explore", *argv, "--out", str(tmp_path)])
+    err = capsys.readouterr().err
+    assert code == 2 and err.count("\n") == 1, err
+    assert fragment in err
+
+
+def test_params_check_names_the_field():
+    with pytest.raises(ConfigError, match="team="):
+        ExploreParams(team="one three").check()
+
+
+# -- physics ------------------------------------------------------------------------------------------------------
+def test_physics_runs_the_same_controllers_and_maps(tmp_path):
+    """A short physics run of the small world: the roles start, explorers are sent out and map through MuJoCo's
+    rangefinders; the map so far matches the true world."""
+    params = ExploreParams(team="1 2", bog_share=0.0, **SMALL)
+    result = run_trial(TrialConfig(mission="explore", params=params, seed=2, duration=90.0, out=str(tmp_path)),
+                       progress=False)
+    metrics = result.summary["metrics"]
+    assert result.status in ("completed", "failed") and result.summary["error"] is None
+    assert len(events({"metrics": metrics}, "assigned")) >= 2
+    assert metrics["explored_share"] > 0.15 and metrics["map_accuracy"] >= 0.9
+    assert (result.run_dir / "map.png").exists() and (result.run_dir / "coverage.png").exists()
