@@ -664,8 +664,9 @@ def generate(config: TrialConfig, mission) -> Scenario:
 
     newcomers = [(f.robot, f.options["kind"]) for f in config.faults if f.kind == "add-robot"]
     world = mission.scenario(config.params, RandomStreams(config.seed).get("mission", "layout"), newcomers)
+    default = getattr(mission, "duration_of", lambda params: mission.default_duration)(config.params)
     scenario = dataclasses.replace(world, mission=config.mission, seed=config.seed,
-                                   duration=config.duration or mission.default_duration, timing=config.timing,
+                                   duration=config.duration or default, timing=config.timing,
                                    radio=config.radio, positioning=config.positioning)
     return load(to_data(scenario), mission)  # as a file would give it: plain floats, tuples, checked ranges
 

@@ -89,7 +89,7 @@ class Explorer:
         self.bog_capable = bog_capable
         self.radius = radius
         self.params = params
-        self.outgoing = territory.unexplored_map()
+        self.outgoing = territory.unexplored_map(navigator.grid.params)  # mapped as its own map is
         self.dirty: set[int] = set()
         self.sensing_range = params.waypoints.sensing_range(territory.resolution)
         self.state = "request"  # request, wait, travel, explore, back-out, finished

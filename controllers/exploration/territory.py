@@ -11,7 +11,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from teamsim.controllers.navigation.occupancy_grid import OccupancyGrid
+from teamsim.controllers.navigation.occupancy_grid import MappingParams, OccupancyGrid
 from teamsim.controllers.navigation.two_tier_astar import Partition, partition_global_map
 
 
@@ -85,8 +85,8 @@ class Territory:
         return (min(max(int((y - y0) // self.resolution), 0), last),
                 min(max(int((x - x0) // self.resolution), 0), last))
 
-    def unexplored_map(self) -> OccupancyGrid:
-        return OccupancyGrid.unexplored(self.origin, self.resolution, (self.cells, self.cells))
+    def unexplored_map(self, params: MappingParams = MappingParams()) -> OccupancyGrid:
+        return OccupancyGrid.unexplored(self.origin, self.resolution, (self.cells, self.cells), params)
 
     def local_map_bytes(self, bytes_per_node: int = 8) -> int:
         """One local map's size on the link (§8.2: 32 x 32 doubles, 8 KB)."""

@@ -38,6 +38,12 @@ class MappingParams:
     # With 0.1 m cells these give P(occ_s|occ) from 0.83 near to 0.56 at full range, so every hit counts.
     noise_min: float = 0.005  # NS_min, m, sensor noise at SR_min
     noise_max: float = 0.02  # NS_max, m, sensor noise at SR_max
+    # Which cell a hit marks occupied: "around" the surface (within half a cell of it, as §6.2.2 reads; a cell
+    # whose centre lies just short of a box's face is marked too), or the first cell "beyond" it, whose centre
+    # lies inside the obstacle: a cell is then occupied when its centre is, as the worlds' density rasters count
+    # (docs/decisions.md, "Exploration": the explorers map at 0.3 m, where the difference is a row of cells
+    # along every face and wall).
+    hit_cell: str = "around"
 
 
 def sensor_noise(distance: np.ndarray, params: MappingParams) -> np.ndarray:
@@ -141,8 +147,12 @@ class OccupancyGrid:
         in_beam = (along > 0) & (across <= half_width) & (along <= p.range_max)
         hit = np.isfinite(ranges) & (ranges < p.range_max)
         measured = np.where(hit, ranges, p.range_max)[:, None, None]
-        free = in_beam & (along < measured - self.resolution / 2)
-        occupied = in_beam & hit[:, None, None] & (np.abs(along - measured) <= self.resolution / 2)
+        if p.hit_cell == "beyond":  # the first cell whose centre lies past the surface; those short of it free
+            free = in_beam & (along < measured)
+            occupied = in_beam & hit[:, None, None] & (along >= measured) & (along < measured + self.resolution)
+        else:  # the cell whose centre lies within half a cell of the surface (§6.2.2's "cell at the hit")
+            free = in_beam & (along < measured - self.resolution / 2)
+            occupied = in_beam & hit[:, None, None] & (np.abs(along - measured) <= self.resolution / 2)
         q_free = p_free_given_free(along, p)
         q_occ = p_occupied_given_occupied(sensor_noise(measured, p), self.resolution, self.resolution)
         # (6.5)'s cases: evidence counts only when it is informative (q_occ > 0.5, q_free < 0.5).

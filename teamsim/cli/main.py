@@ -119,7 +119,7 @@ def _build_parser() -> argparse.ArgumentParser:
 
     bench = commands.add_parser("bench", help="benchmarks")
     bench.add_argument("what", choices=("physics", "cleanup", "box-pushing", "render", "nav", "alliance", "allocate",
-                                        "sweep"))
+                                        "sweep", "explore"))
     bench.add_argument("--seconds", type=float, default=None, help="simulated seconds per measurement")
     return parser
 
@@ -323,7 +323,7 @@ def cmd_allocate(args) -> int:
 
 # teamsim bench WHAT: the module that measures it and its function (imported only when asked for)
 BENCHES = {"allocate": ("allocate", "bench_allocate"), "nav": ("nav", "bench_nav"), "sweep": ("sweep", "bench_sweep"),
-           "alliance": ("alliance", "bench_alliance")}
+           "alliance": ("alliance", "bench_alliance"), "explore": ("explore", "bench_explore")}
 
 
 def cmd_bench(args) -> int:
@@ -331,7 +331,8 @@ def cmd_bench(args) -> int:
 
     if args.what in BENCHES:
         module, function = BENCHES[args.what]
-        getattr(importlib.import_module(f"teamsim.bench.{module}"), function)()
+        bench_function = getattr(importlib.import_module(f"teamsim.bench.{module}"), function)
+        bench_function(seconds=args.seconds) if args.what == "explore" else bench_function()
         return 0
     from teamsim.bench import physics as bench
 
