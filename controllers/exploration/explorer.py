@@ -40,8 +40,9 @@ class ExplorerParams:
     waypoint_reach: float = 0.6  # m: a waypoint is visited once the robot's centre is this close
     progress: float = 0.5  # m closer to the current goal that counts as progress
     give_up: float = 45.0  # s without progress: persistent poor progress (§6.2)
-    bog_effort: float = 0.7  # drive effort (share of the motors' limit) that is "abnormally high" ...
-    bog_speed: float = 0.01  # ... while the robot still moves (m/s; stalled against a box it reads 0) ...
+    bog_effort: float = 0.25  # drive effort (share of the motors' limit) that is "abnormally high" (measured in
+    # physics: at most 0.09 on firm ground, accelerating; in a bog 0.3 (tracked, full speed) to 1.0 (diffdrive)) ...
+    bog_speed: float = 0.002  # ... while the robot still creeps (m/s; stalled against a box it reads 0) ...
     bog_time: float = 1.5  # ... for this long: a bog
     back_out_limit: float = 60.0  # s of reversing at most; it also stops when something behind stalls it
     back_out_distance: float = 2.0  # m of its own trail to reverse beyond where the bog slowed it
@@ -224,9 +225,15 @@ class Explorer:
 
     # -- mapping ------------------------------------------------------------------------------------------------
     def _map(self, obs, pose) -> None:
-        """(6.3)-(6.5) into the outgoing map (the navigator's HRDU maps its own grid as it decides)."""
-        self.outgoing.update(pose, obs.ir_range, obs.ir_bearings, sensor_radius=self.nav.sensor_radius,
-                             centre_offset=self.nav.offset, footprint_radius=self.radius)
+        """(6.3)-(6.5) into the outgoing map. The navigator's HRDU maps its own grid as it decides; when it did so
+        this tick, from the same pose, its evidence is applied here as it is (the same reading on the same frame)."""
+        shared = self.nav.last_evidence
+        if shared is not None and shared.time == obs.time and shared.pose == tuple(pose) \
+                and self.nav.radius == self.radius:
+            self.outgoing.apply(shared)
+        else:
+            self.outgoing.update(pose, obs.ir_range, obs.ir_bearings, sensor_radius=self.nav.sensor_radius,
+                                 centre_offset=self.nav.offset, footprint_radius=self.radius)
         reach = self.radius + self.outgoing.params.range_max
         for dx in (-reach, reach):
             for dy in (-reach, reach):
@@ -271,9 +278,8 @@ class Explorer:
         wheeled robot creeps, a tracked one keeps its speed at full effort; a stall against a box, at zero speed,
         is not a bog)."""
         p = self.params
-        commanded = abs(self.nav.state.v)
-        effort = getattr(obs, "drive_effort", None)
-        slow = (effort is not None and obs.velocity is not None and commanded > 0.05 and effort >= p.bog_effort
+        effort = obs.drive_effort
+        slow = (effort is not None and obs.velocity is not None and effort >= p.bog_effort
                 and abs(obs.velocity[0]) >= p.bog_speed)
         if not slow:
             self.slow_since = None

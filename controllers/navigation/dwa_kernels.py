@@ -5,6 +5,7 @@
 - :func:`stops_clear`: ST_v (3.33) by integration, whether the robot, holding a candidate one cycle and then
   braking along its curvature, keeps its circle clear of every point;
 - :func:`thin_to_robot_frame`: the obstacle memory, one point per 2 cm square, in the robot frame.
+- :func:`path_blocked`: HRDU's re-planning trigger, an impassable cell near the path ahead.
 
 The first two are :class:`~teamsim.controllers.navigation.dynamic_window.DynamicWindow`'s methods of the same
 names, whose docstrings give the reasoning; here the same arithmetic runs as plain loops, one candidate and one
@@ -164,3 +165,30 @@ def thin_to_robot_frame(world, cell, ox, oy, c, s, offset):  # noqa: PLR0913
         out[kept, 0], out[kept, 1] = c * dx + s * dy - offset, -s * dx + c * dy
         kept += 1
     return out[:kept].copy()
+
+
+@njit("b1(f8[:, :], f8[:, :], f8, f8, f8, f8, f8)", cache=True)
+def path_blocked(probabilities, ahead, origin_x, origin_y, resolution, reach, threshold):  # noqa: PLR0913
+    """Whether a cell of the occupancy grid (``probabilities``, lower-left corner at the origin) at or above the
+    impassable ``threshold`` has its centre within ``reach`` of a point of the path ``ahead`` ((n, 2) world
+    points). Only the cells in the bounding box of the points' cells widened by ceil(reach / resolution) cells
+    are looked at: a cell outside it has its centre more than ``reach`` from every point."""
+    if ahead.shape[0] == 0:
+        raise ValueError("no path ahead")
+    margin = int(math.ceil(reach / resolution))
+    row_lo = col_lo = np.iinfo(np.int64).max
+    row_hi = col_hi = np.iinfo(np.int64).min
+    for k in range(ahead.shape[0]):  # the points' cells, as OccupancyGrid.world_to_cell
+        row = int(math.floor((ahead[k, 1] - origin_y) / resolution))
+        col = int(math.floor((ahead[k, 0] - origin_x) / resolution))
+        row_lo, row_hi, col_lo, col_hi = min(row_lo, row), max(row_hi, row), min(col_lo, col), max(col_hi, col)
+    rows, cols = probabilities.shape
+    for i in range(max(row_lo - margin, 0), min(row_hi + margin + 1, rows)):
+        for j in range(max(col_lo - margin, 0), min(col_hi + margin + 1, cols)):
+            if not probabilities[i, j] >= threshold:
+                continue
+            x, y = origin_x + (j + 0.5) * resolution, origin_y + (i + 0.5) * resolution  # OccupancyGrid.cell_to_world
+            for k in range(ahead.shape[0]):
+                if math.hypot(x - ahead[k, 0], y - ahead[k, 1]) <= reach:
+                    return True
+    return False

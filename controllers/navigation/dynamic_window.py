@@ -111,7 +111,7 @@ import numpy as np
 from teamsim.controllers.base import Command, Observation
 from teamsim.controllers.navigation import dwa_kernels as kernels
 from teamsim.controllers.navigation.astar import PlannerParams, WeightAdaptation, adapt_weights, plan_on_grid
-from teamsim.controllers.navigation.occupancy_grid import OccupancyGrid
+from teamsim.controllers.navigation.occupancy_grid import Evidence, OccupancyGrid
 from teamsim.controllers.navigation.path_following import PathFollower, PathFollowing
 from teamsim.controllers.navigation.trap_escape import TrapEscape
 from teamsim.controllers.navigation.polar_histogram import (DirectionSensorParams, modified_target_heading,
@@ -863,6 +863,9 @@ class HRDU(HRDK):
         self.last_plan_time = -math.inf
         self.progress_check = None  # (time, distance to goal) at the last progress check
         self.replans = 0  # plans after the first
+        # The last reading's evidence mapped into ``grid``, with its pose and time: another grid of the same frame
+        # (an explorer's outgoing map) can apply it rather than compute it again.
+        self.last_evidence: Evidence | None = None
 
     @property
     def name(self) -> str:
@@ -873,8 +876,9 @@ class HRDU(HRDK):
         self.progress_check = None
 
     def waypoint(self, pose, centre, obs):
-        self.grid.update(pose, obs.ir_range, obs.ir_bearings, sensor_radius=self.sensor_radius,
-                         centre_offset=self.offset, footprint_radius=self.radius)
+        evidence = self.grid.update(pose, obs.ir_range, obs.ir_bearings, sensor_radius=self.sensor_radius,
+                                    centre_offset=self.offset, footprint_radius=self.radius)
+        self.last_evidence = replace(evidence, time=obs.time)
         distance = math.dist(centre, self.goal)
         if self.follower is None:
             self.plan(centre)
@@ -896,16 +900,9 @@ class HRDU(HRDK):
         return super().waypoint(pose, centre, obs)
 
     def path_blocked(self) -> bool:
-        """Whether a cell now mapped impassable lies within the planning inflation of the path just ahead."""
+        """Whether a cell now mapped impassable lies within the planning inflation of the path just ahead
+        (``dwa_kernels.path_blocked``)."""
         ahead = self.follower.path[self.follower.node:self.follower.node + self.replanning.blocked_lookahead]
-        reach = self.radius + self.following.clearance
-        rows, cols = self.grid.world_to_cell(ahead[:, 0], ahead[:, 1])
-        margin = int(math.ceil(reach / self.grid.resolution))
-        r0, c0 = max(int(rows.min()) - margin, 0), max(int(cols.min()) - margin, 0)
-        window = self.grid.probabilities[r0:int(rows.max()) + margin + 1, c0:int(cols.max()) + margin + 1]
-        occupied_rows, occupied_cols = np.nonzero(window >= self.planner.occupied_threshold)
-        if occupied_rows.size == 0:
-            return False
-        x, y = self.grid.cell_to_world(occupied_rows + r0, occupied_cols + c0)
-        gaps = np.hypot(x[:, None] - ahead[:, 0], y[:, None] - ahead[:, 1])
-        return bool((gaps <= reach).any())
+        return kernels.path_blocked(self.grid.probabilities, np.asarray(ahead, float), *self.grid.origin,
+                                    self.grid.resolution, self.radius + self.following.clearance,
+                                    self.planner.occupied_threshold)

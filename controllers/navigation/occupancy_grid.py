@@ -16,12 +16,24 @@ Update, per cell and beam (§6.2.2):
         q = P(uocc_s|uocc) if it is below 0.5 (free evidence); otherwise P_u = P_i.
 (6.5) multiplies a cell's odds by q/(1-q); all the beams of one reading are applied together by adding their
 log-odds, which is (6.5) applied once per beam, and the result is then clamped.
+
+A reading's evidence (its summed log-odds over the window of cells it reaches, ``OccupancyGrid.evidence``) does not
+depend on the grid's probabilities, so one computation serves every grid of the same frame (``apply``): an explorer
+maps the same reading into its navigator's grid and its outgoing map. The evidence is a compiled loop (numba), beam
+by beam and cell by cell, that repeats the numpy form's arithmetic operation for operation (the numpy form is the
+test oracle, ``tests/controllers/navigation/test_occupancy_grid.py``): each cell's log-odds are summed in beam
+order as ``np.sum(axis=0)`` sums them, and by numpy's pairwise order in the one case where numpy uses it (a window
+of a single cell). ``math.log``, ``exp``, ``cos``, ``sin``, ``tan`` and ``hypot`` compiled are the C library's, as
+numpy's float64 ufuncs are on x86-64 without AVX-512 (with it numpy has its own log, exp, sin and cos, and the
+last bit may differ).
 """
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
+from numba import njit
 
 
 @dataclass(frozen=True)
@@ -44,6 +56,17 @@ class MappingParams:
     # (docs/decisions.md, "Exploration": the explorers map at 0.3 m, where the difference is a row of cells
     # along every face and wall).
     hit_cell: str = "around"
+
+
+@dataclass(frozen=True)
+class Evidence:
+    """One IR reading's evidence over the window of grid cells it can reach (``OccupancyGrid.evidence``)."""
+    rows: slice  # the window's rows of the grid
+    cols: slice  # and its columns
+    log_odds: np.ndarray  # (rows, cols): per cell, the sum over beams of logit(q) (6.3)-(6.5), then the footprint's
+    frame: tuple  # the ``OccupancyGrid.frame`` it was computed for: it applies to any grid of that frame
+    pose: tuple[float, float, float]  # the robot pose (x, y, heading) of the reading
+    time: float | None = None  # when the reading was taken, if the caller records it (HRDU does)
 
 
 def sensor_noise(distance: np.ndarray, params: MappingParams) -> np.ndarray:
@@ -71,8 +94,8 @@ def bayes_update(prior: np.ndarray, q: np.ndarray) -> np.ndarray:
     return prior * q / (prior * q + (1.0 - prior) * (1.0 - q))
 
 
-def _logit(p: np.ndarray) -> np.ndarray:
-    return np.log(p / (1.0 - p))
+def _floats(values) -> np.ndarray:
+    return np.ascontiguousarray(values, dtype=float).reshape(-1)
 
 
 class OccupancyGrid:
@@ -116,10 +139,26 @@ class OccupancyGrid:
         row, col = np.asarray(row), np.asarray(col)
         return (row >= 0) & (row < self.shape[0]) & (col >= 0) & (col < self.shape[1])
 
+    @property
+    def frame(self) -> tuple:
+        """What evidence depends on besides the reading: origin, resolution, shape and mapping parameters."""
+        return self.origin, self.resolution, self.shape, self.params
+
     def update(self, pose: tuple[float, float, float], ranges: np.ndarray, bearings: np.ndarray, *,
                sensor_radius: float | np.ndarray, centre_offset: float = 0.0,
-               footprint_radius: float = 0.0) -> None:
-        """Integrate one IR reading taken at robot ``pose`` (x, y, heading).
+               footprint_radius: float = 0.0) -> Evidence:
+        """Integrate one IR reading taken at robot ``pose`` (x, y, heading): ``apply(evidence(...))``; returns the
+        evidence applied."""
+        evidence = self.evidence(pose, ranges, bearings, sensor_radius=sensor_radius, centre_offset=centre_offset,
+                                 footprint_radius=footprint_radius)
+        self.apply(evidence)
+        return evidence
+
+    def evidence(self, pose: tuple[float, float, float], ranges: np.ndarray, bearings: np.ndarray, *,
+                 sensor_radius: float | np.ndarray, centre_offset: float = 0.0,
+                 footprint_radius: float = 0.0) -> Evidence:
+        """The evidence (6.3)-(6.4) of one IR reading taken at robot ``pose`` (x, y, heading), as summed log-odds
+        over the window of cells it can reach; the grid is not changed.
 
         The sensors sit ``sensor_radius`` (one for all, or one per sensor) from the robot's physical centre,
         which is ``centre_offset`` ahead of the pose's reference point, each looking out along its body-frame
@@ -127,43 +166,23 @@ class OccupancyGrid:
         ``footprint_radius`` of the centre are free (the robot is standing on them)."""
         p = self.params
         x, y, heading = (float(v) for v in pose)
-        ranges = np.asarray(ranges, float)
-        bearings = np.asarray(bearings, float)
-        cx, cy = x + centre_offset * np.cos(heading), y + centre_offset * np.sin(heading)
-        directions = heading + bearings
-        ux, uy = np.cos(directions), np.sin(directions)
-        sx, sy = cx + sensor_radius * ux, cy + sensor_radius * uy
-        reach = float(np.max(sensor_radius)) + p.range_max + self.resolution
-        rows, cols = self.window(cx, cy, reach)
-        if rows.size == 0 or cols.size == 0:
-            return
-        wx, wy = self.cell_to_world(rows[:, None], cols[None, :])  # (R, C) cell centres
-        # Per beam and cell: distance along the beam and off its centre line, (beams, R, C).
-        dx, dy = wx[None] - sx[:, None, None], wy[None] - sy[:, None, None]
-        along = dx * ux[:, None, None] + dy * uy[:, None, None]
-        across = np.abs(dx * uy[:, None, None] - dy * ux[:, None, None])
-        # The cone, never narrower than one cell, so that a beam marks every cell its centre line crosses.
-        half_width = np.maximum(along * np.tan(p.beam_angle / 2), self.resolution / 2)
-        in_beam = (along > 0) & (across <= half_width) & (along <= p.range_max)
-        hit = np.isfinite(ranges) & (ranges < p.range_max)
-        measured = np.where(hit, ranges, p.range_max)[:, None, None]
-        if p.hit_cell == "beyond":  # the first cell whose centre lies past the surface; those short of it free
-            free = in_beam & (along < measured)
-            occupied = in_beam & hit[:, None, None] & (along >= measured) & (along < measured + self.resolution)
-        else:  # the cell whose centre lies within half a cell of the surface (§6.2.2's "cell at the hit")
-            free = in_beam & (along < measured - self.resolution / 2)
-            occupied = in_beam & hit[:, None, None] & (np.abs(along - measured) <= self.resolution / 2)
-        q_free = p_free_given_free(along, p)
-        q_occ = p_occupied_given_occupied(sensor_noise(measured, p), self.resolution, self.resolution)
-        # (6.5)'s cases: evidence counts only when it is informative (q_occ > 0.5, q_free < 0.5).
-        evidence = (np.where(free & (q_free < 0.5), _logit(q_free), 0.0).sum(axis=0)
-                    + np.where(occupied & (q_occ > 0.5), _logit(q_occ), 0.0).sum(axis=0))
-        if footprint_radius > 0:
-            under_robot = np.hypot(wx - cx, wy - cy) <= footprint_radius
-            evidence += np.where(under_robot, _logit(np.asarray(p.p_free_near)), 0.0)
-        block = np.ix_(rows, cols)
-        posterior = 1.0 / (1.0 + np.exp(-(_logit(self.probabilities[block]) + evidence)))
-        self.probabilities[block] = np.clip(posterior, p.p_min, p.p_max)
+        ranges, bearings, radius = _floats(ranges), _floats(bearings), _floats(sensor_radius)
+        if radius.size != 1 and radius.size != ranges.size:
+            raise ValueError("one sensor radius for all sensors, or one per sensor")
+        row0, col0, log_odds = _reading_log_odds(
+            x, y, heading, ranges, bearings, radius, float(centre_offset), float(footprint_radius), *self.origin,
+            self.resolution, *self.shape, float(p.beam_angle), p.range_min, p.range_max, p.p_free_near,
+            p.p_free_far, p.noise_min, p.noise_max, p.hit_cell == "beyond")
+        return Evidence(slice(row0, row0 + log_odds.shape[0]), slice(col0, col0 + log_odds.shape[1]), log_odds,
+                        self.frame, (x, y, heading))
+
+    def apply(self, evidence: Evidence) -> None:
+        """(6.5) for every beam at once: add the evidence's log-odds to the window's cells, then clamp. The evidence
+        may come from another grid of the same ``frame``."""
+        if evidence.frame != self.frame:
+            raise ValueError("evidence computed for a grid of another origin, resolution, shape or parameters")
+        _apply_log_odds(self.probabilities, evidence.rows.start, evidence.cols.start, evidence.log_odds,
+                        self.params.p_min, self.params.p_max)
 
     def window(self, x: float, y: float, reach: float) -> tuple[np.ndarray, np.ndarray]:
         """Row and column indices of the grid cells within ``reach`` (a square) of (x, y)."""
@@ -172,3 +191,135 @@ class OccupancyGrid:
         rows = np.arange(max(int(row_lo), 0), min(int(row_hi), self.shape[0] - 1) + 1)
         cols = np.arange(max(int(col_lo), 0), min(int(col_hi), self.shape[1] - 1) + 1)
         return rows, cols
+
+
+@njit("i8(f8, f8, f8)", cache=True)
+def _cell_index(coordinate, origin, resolution):
+    """``world_to_cell`` along one axis."""
+    return int(math.floor((coordinate - origin) / resolution))
+
+
+@njit("f8(f8)", cache=True)
+def _logit(p):
+    return math.log(p / (1.0 - p))
+
+
+@njit("f8(f8, f8, f8, f8, f8)", cache=True)
+def _linear_in_range(distance, range_min, range_max, at_min, at_max):
+    """The linear models of ``sensor_noise`` and ``p_free_given_free`` (6.4), operation for operation."""
+    fraction = (distance - range_min) / (range_max - range_min)
+    return at_min + (at_max - at_min) * min(max(fraction, 0.0), 1.0)
+
+
+@njit("b1(f8, f8, f8, f8, f8)", cache=True)
+def _in_cone(along, across, tan_half, resolution, range_max):
+    """Whether a cell ``along`` the beam and ``across`` it lies in the cone, never narrower than one cell so that a
+    beam marks every cell its centre line crosses."""
+    half_width = max(along * tan_half, resolution / 2)
+    return along > 0 and across <= half_width and along <= range_max
+
+
+@njit("UniTuple(b1, 2)(f8, f8, f8, b1, b1)", cache=True)
+def _marks(along, measured, resolution, hit, beyond):
+    """Whether a cell of the cone ``along`` the beam is evidence of free space, and of an obstacle, by
+    ``MappingParams.hit_cell``."""
+    if beyond:  # the first cell whose centre lies past the surface; those short of it free
+        return along < measured, hit and along >= measured and along < measured + resolution
+    # the cell whose centre lies within half a cell of the surface (§6.2.2's "cell at the hit")
+    return along < measured - resolution / 2, hit and abs(along - measured) <= resolution / 2
+
+
+@njit("f8(f8[:])", cache=True)
+def _numpy_sum(values):
+    """``np.add.reduce`` of ``values`` when numpy runs them as its inner loop, by its pairwise summation
+    (``pairwise_sum``): in order below 8 terms, eight interleaved partial sums up to 128, halves of a multiple of 8
+    terms above."""
+    n = values.shape[0]
+    if n > 128:
+        half = n // 2
+        half -= half % 8
+        return _numpy_sum(values[:half]) + _numpy_sum(values[half:])
+    total = 0.0
+    k = 0
+    if n >= 8:
+        partial = values[:8].copy()
+        for k in range(8, n - n % 8, 8):
+            for j in range(8):
+                partial[j] += values[k + j]
+        k = n - n % 8
+        total = ((partial[0] + partial[1]) + (partial[2] + partial[3])) + ((partial[4] + partial[5])
+                                                                           + (partial[6] + partial[7]))
+    for j in range(k, n):
+        total += values[j]
+    return total
+
+
+@njit("Tuple((i8, i8, f8[:, ::1]))(f8, f8, f8, f8[::1], f8[::1], f8[::1], f8, f8, f8, f8, f8, i8, i8, f8, f8, f8, "
+      "f8, f8, f8, f8, b1)", cache=True)
+def _reading_log_odds(x, y, heading, ranges, bearings, sensor_radius, centre_offset,  # noqa: PLR0913
+                      footprint_radius, origin_x, origin_y, resolution, n_rows, n_cols, beam_angle, range_min,
+                      range_max, p_free_near, p_free_far, noise_min, noise_max, beyond):
+    """(row0, col0, log-odds) of one reading's window, as ``OccupancyGrid.evidence`` describes it: per beam its
+    cone's free evidence (6.4) and its hit's occupied evidence (6.3), as logit(q) where informative (6.5), summed
+    over the beams in their order as ``np.sum(axis=0)`` sums them (numpy's pairwise order for a single cell);
+    then the footprint's free evidence."""
+    cx, cy = x + centre_offset * math.cos(heading), y + centre_offset * math.sin(heading)
+    reach = sensor_radius.max() + range_max + resolution
+    row0 = max(_cell_index(cy - reach, origin_y, resolution), 0)
+    col0 = max(_cell_index(cx - reach, origin_x, resolution), 0)
+    rows = min(_cell_index(cy + reach, origin_y, resolution), n_rows - 1) + 1 - row0
+    cols = min(_cell_index(cx + reach, origin_x, resolution), n_cols - 1) + 1 - col0
+    if rows <= 0 or cols <= 0:
+        return row0, col0, np.zeros((0, 0))
+    wx = origin_x + (np.arange(col0, col0 + cols) + 0.5) * resolution  # cell centres, as ``cell_to_world``
+    wy = origin_y + (np.arange(row0, row0 + rows) + 0.5) * resolution
+    single = rows * cols == 1  # one cell: every beam's terms kept, for numpy's pairwise order
+    free = np.zeros((ranges.shape[0] if single else 1, rows, cols))
+    occupied = np.zeros_like(free)
+    tan_half = math.tan(beam_angle / 2)
+    area = resolution * resolution
+    for b in range(ranges.shape[0]):
+        k = b if single else 0
+        direction = heading + bearings[b]
+        ux, uy = math.cos(direction), math.sin(direction)
+        radius = sensor_radius[0] if sensor_radius.shape[0] == 1 else sensor_radius[b]
+        sx, sy = cx + radius * ux, cy + radius * uy
+        hit = math.isfinite(ranges[b]) and ranges[b] < range_max
+        measured = ranges[b] if hit else range_max
+        noise = _linear_in_range(measured, range_min, range_max, noise_min, noise_max)
+        q_occupied = area / (area + 2.0 * noise * (resolution + resolution))  # (6.3)
+        for i in range(rows):
+            dy = wy[i] - sy
+            for j in range(cols):
+                dx = wx[j] - sx
+                along = dx * ux + dy * uy
+                if not _in_cone(along, abs(dx * uy - dy * ux), tan_half, resolution, range_max):
+                    continue
+                is_free, is_occupied = _marks(along, measured, resolution, hit, beyond)
+                # (6.5)'s cases: evidence counts only when it is informative (q_free < 0.5, q_occupied > 0.5).
+                if is_free:
+                    q_free = _linear_in_range(along, range_min, range_max, p_free_near, p_free_far)  # (6.4)
+                    if q_free < 0.5:
+                        free[k, i, j] += _logit(q_free)
+                if is_occupied and q_occupied > 0.5:
+                    occupied[k, i, j] += _logit(q_occupied)
+    if single:
+        log_odds = np.full((1, 1), _numpy_sum(free[:, 0, 0]) + _numpy_sum(occupied[:, 0, 0]))
+    else:
+        log_odds = free[0] + occupied[0]
+    if footprint_radius > 0:
+        for i in range(rows):
+            for j in range(cols):
+                if math.hypot(wx[j] - cx, wy[i] - cy) <= footprint_radius:
+                    log_odds[i, j] += _logit(p_free_near)
+    return row0, col0, log_odds
+
+
+@njit("void(f8[:, :], i8, i8, f8[:, ::1], f8, f8)", cache=True)
+def _apply_log_odds(probabilities, row0, col0, log_odds, p_min, p_max):
+    """(6.5) in log-odds over the window at (row0, col0): p = 1 / (1 + exp(-(logit(p) + evidence))), clamped."""
+    for i in range(log_odds.shape[0]):
+        for j in range(log_odds.shape[1]):
+            prior = probabilities[row0 + i, col0 + j]
+            posterior = 1.0 / (1.0 + math.exp(-(_logit(prior) + log_odds[i, j])))
+            probabilities[row0 + i, col0 + j] = min(max(posterior, p_min), p_max)

@@ -26,6 +26,7 @@ Frames and choices where the thesis is silent:
 """
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 
@@ -59,13 +60,26 @@ def candidate_directions(count: int) -> np.ndarray:
     return wrap(2 * np.pi * np.arange(count) / count)
 
 
+@functools.lru_cache(maxsize=8)
+def _candidates(count: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``candidate_directions(count)`` and their cosines and sines: constants, computed once per count."""
+    directions = candidate_directions(count)
+    return directions, np.cos(directions), np.sin(directions)
+
+
 def obstacle_distances(points: np.ndarray, directions: np.ndarray, robot_radius: float,
                        max_distance: float) -> np.ndarray:
     """d_ob per direction: r_m plus the free travel of the point robot before an enlarged obstacle, limited to
     [r_m, d_obmax]. ``points`` are obstacle points (m, 2) relative to the robot's centre, in the robot frame."""
+    return _distances_along(points, np.cos(directions), np.sin(directions), robot_radius, max_distance)
+
+
+def _distances_along(points: np.ndarray, cos: np.ndarray, sin: np.ndarray, robot_radius: float,
+                     max_distance: float) -> np.ndarray:
+    """``obstacle_distances`` for directions given by their cosines and sines."""
     points = np.asarray(points, float).reshape(-1, 2)
-    return _obstacle_distances(np.cos(directions), np.sin(directions), np.ascontiguousarray(points[:, 0]),
-                               np.ascontiguousarray(points[:, 1]), robot_radius, robot_radius ** 2, max_distance)
+    return _obstacle_distances(cos, sin, np.ascontiguousarray(points[:, 0]), np.ascontiguousarray(points[:, 1]),
+                               robot_radius, robot_radius ** 2, max_distance)
 
 
 @njit("f8[::1](f8[::1], f8[::1], f8[::1], f8[::1], f8, f8, f8)", cache=True)
@@ -114,8 +128,8 @@ def modified_target_heading(points: np.ndarray, target: float, robot_radius: flo
     Directions scoring within ``params.tie_tolerance`` of the best count as ties, broken towards ``previous``
     (the last theta_tmod, in the current robot frame): an obstacle dead ahead scores both ways round it almost
     equally, and re-deciding every cycle would swing the robot between them."""
-    directions = candidate_directions(params.directions)
-    distances = obstacle_distances(points, directions, robot_radius, params.max_distance)
+    directions, cos, sin = _candidates(params.directions)
+    distances = _distances_along(points, cos, sin, robot_radius, params.max_distance)
     scores = direction_objective(directions, target, smooth(distances, params.smoothing), params)
     if previous is None:
         return float(directions[np.argmax(scores)])

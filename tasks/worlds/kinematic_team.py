@@ -1,11 +1,12 @@
 """A team without physics: the explore mission's kinematic backend, as Chand's own MATLAB simulations ran (§8.2).
 
-Each robot is a ``KinematicBody`` in the world's boxes (ideal IR ranges, exact positioning fixes every tick), its
-controller the same as in physics, its messages on the same ``teamsim.network``. A motion that would touch a box,
+Each robot is a ``KinematicBody`` in the world's boxes (ideal IR ranges to the boxes, walls and the other robots'
+enclosing circles; exact positioning fixes every tick), its controller the same as in physics, its messages on
+the same ``teamsim.network``. A motion that would touch a box,
 a wall or another robot is refused and the robot halted, as a bumper stops it. Terrain (docs/decisions.md,
 "Exploration"): in a bog a robot moves at its traversability times the commanded speed, the physics bog's top
-speed; the drive effort a controller reads is the share of the motors' force the motion needs, ``FIRM_EFFORT`` of
-full effort per unit of speed on firm ground and 1 / traversability in a bog, capped at 1. Faults: kill and remove
+speed; the drive effort a controller reads is the share of the motors' force the motion needs, as measured on the
+physics robots: ``FIRM_EFFORT`` per unit of speed on firm ground, ``BOG_EFFORT`` / traversability in a bog. Faults: kill and remove
 (the robot stops and falls silent), radio-off, break-motor (it cannot move), slow.
 """
 from __future__ import annotations
@@ -23,7 +24,10 @@ from teamsim.network import Network
 from teamsim.positioning import PoseFix
 from teamsim.tasks.worlds.navigation import KinematicBody, NavWorld
 
-FIRM_EFFORT = 0.3  # share of full effort to hold top speed on firm ground (rolling resistance; assumed)
+# The drive effort model, from the physics robots (decisions.md, "Exploration"): on firm ground about 0.05 of full
+# effort at top speed; in a bog 0.3 at a tracked robot's top speed, the wheeled robots' motors saturating.
+FIRM_EFFORT = 0.05  # effort per unit of speed / v_max on firm ground
+BOG_EFFORT = 0.3  # effort per unit of speed / (traversability x v_max) in a bog
 KINEMATIC_FAULTS = ("kill", "remove", "radio-off", "break-motor", "slow")
 
 
@@ -75,7 +79,7 @@ class KinematicTeam:
 
     def _control(self, name: str, member: Member, now: float) -> None:
         body = member.body
-        ranges = body.ranges(self.world)
+        ranges = self._ranges(name, body)
         observation = Observation(time=now, robot=name, ir_raw=ranges, ir_range=ranges, ir_bearings=body.bearings,
                                   pose=PoseFix(body.x, body.y, body.heading, now),
                                   inbox=tuple(self.network.take_inbox(name)),
@@ -91,14 +95,26 @@ class KinematicTeam:
         terrain = member.traversability if bogged else 1.0
         x, y, heading, velocity = body.motion(command, terrain * member.speed_factor)
         v_max = body.robot.limits.v_max
-        member.effort = min(1.0, abs(body.slew.v) / v_max * (1.0 / max(member.traversability, 1e-3) if bogged
-                                                              else FIRM_EFFORT))
+        share = abs(body.slew.v) / v_max
+        member.effort = min(1.0, BOG_EFFORT * share / max(member.traversability, 1e-3) if bogged
+                            else FIRM_EFFORT * share)
         if body.gap(self.world, x, y, heading) < 0 or self._bumps(name, body, x, y, heading):
             member.touches += 1
             body.halt()
             return
         member.travelled += body.move(x, y, heading, velocity)
         member.trail.append((now, body.x, body.y))
+
+    def _ranges(self, name: str, body: KinematicBody) -> np.ndarray:
+        """IR ranges to the boxes and walls, and to the other live robots' enclosing circles."""
+        ranges = body.ranges(self.world)
+        others = [m.body for other, m in self.members.items() if other != name and m.alive]
+        if not others:
+            return ranges
+        centres = np.array([b.centre(b.x, b.y, b.heading) for b in others])
+        radii = np.array([b.robot.radius for b in others])
+        origins, directions = body.rays()
+        return np.minimum(ranges, circle_ranges(origins, directions, centres, radii, body.robot.ir_range))
 
     def _bumps(self, name: str, body: KinematicBody, x: float, y: float, heading: float) -> bool:
         """The move would bring its enclosing circle closer into another live robot's."""
@@ -125,3 +141,16 @@ class KinematicTeam:
         elif fault.kind == "slow":
             member.speed_factor = float(fault.options.get("factor", 0.5))
         self.events.append({"t": round(self.time, 6), "event": "fault", **fault.describe()})
+
+
+def circle_ranges(origins: np.ndarray, directions: np.ndarray, centres: np.ndarray, radii: np.ndarray,
+                  max_range: float) -> np.ndarray:
+    """Distance along each ray (origin (n, 2), unit direction (n, 2)) to the nearest circle it enters ahead,
+    ``inf`` where none lies within ``max_range``; a ray starting inside a circle does not see it."""
+    offset = centres[None, :, :] - origins[:, None, :]  # (rays, circles, 2)
+    along = np.einsum("rcd,rd->rc", offset, directions)
+    miss = np.einsum("rcd,rcd->rc", offset, offset) - along ** 2  # squared distance of the centre off the ray
+    depth = radii[None, :] ** 2 - miss
+    entry = along - np.sqrt(np.maximum(depth, 0.0))
+    seen = (depth >= 0) & (entry > 0) & (entry <= max_range)
+    return np.where(seen, entry, np.inf).min(axis=1)

@@ -313,11 +313,14 @@ class KinematicBody:
         offset = self.robot.centre_offset
         return x + offset * math.cos(heading), y + offset * math.sin(heading)
 
-    def ranges(self, world: NavWorld) -> np.ndarray:
+    def rays(self) -> tuple[np.ndarray, np.ndarray]:
+        """Each IR sensor's position and unit direction in the world, (n, 2) each."""
         cx, cy = self.centre(self.x, self.y, self.heading)
         directions = np.column_stack([np.cos(self.heading + self.bearings), np.sin(self.heading + self.bearings)])
-        return ray_ranges(world, np.array([cx, cy]) + self.sensor_radius[:, None] * directions, directions,
-                          self.robot.ir_range)
+        return np.array([cx, cy]) + self.sensor_radius[:, None] * directions, directions
+
+    def ranges(self, world: NavWorld) -> np.ndarray:
+        return ray_ranges(world, *self.rays(), self.robot.ir_range)
 
     def motion(self, command, speed_scale: float = 1.0) -> tuple[float, float, float, tuple[float, float]]:
         """Where this tick's command would take the robot, and the odometry it would read."""

@@ -191,3 +191,32 @@ def test_diffdrive_radius_is_a_parameter():
         assert model.geom_size[shell][0] == pytest.approx(radius)
         site = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_SITE, f"{name}/ir0")
         assert np.hypot(*model.site_pos[site][:2]) == pytest.approx(radius, abs=0.01)
+
+
+@pytest.mark.parametrize("kind, cruise", [("diffdrive", 0.5), ("tricycle", 0.5), ("tracked", 0.4)])
+def test_drive_effort_is_high_in_a_bog_and_only_there(kind, cruise):
+    """The explorers' bog sign (Chand §6.2: high motor effort): ``Observation.drive_effort`` at or above 0.25 for
+    1.5 s (15 ticks) running, which is where the explore mission's explorers call it a bog (decisions.md,
+    "Exploration"), never happens driving and speeding up on firm ground (the effort peaks there at about 0.2
+    for a moment as the robot accelerates) and does happen once the robot is wholly in a bog, whatever its drive."""
+    bog = Bog(0.0, 0.0, 4.0, 3.0)
+    world, red = solo(kind, lambda o: (cruise, 0.0), x=-5.5, bogs=[bog])
+    firm, boggy = [], []
+    for _ in range(150):
+        run_for(world, 0.1)
+        x = world.pose(red)[0]
+        effort = world.controllers["red"].observations[-1].drive_effort
+        if x + red.model.footprint_radius < -4.0:
+            firm.append(effort)
+        elif x - red.model.footprint_radius > -4.0:
+            boggy.append(effort)
+
+    def longest_high_run(efforts):
+        run = best = 0
+        for effort in efforts:
+            run = run + 1 if effort >= 0.25 else 0
+            best = max(best, run)
+        return best
+
+    assert len(firm) >= 20 and longest_high_run(firm) < 15 and max(firm) < 0.25
+    assert longest_high_run(boggy) >= 15

@@ -1,8 +1,9 @@
 """Unit tests for Chand's modified A* (§3.2.2, eq. 3.1-3.8): the cost terms by hand, the numpy helpers against
 brute force, optimality against the textbook ``reference_astar`` on random grids, the corner rule and the partial
-path to an unreachable goal."""
+path to an unreachable goal; the compiled heap search against the plain Python loop it replaced."""
 from __future__ import annotations
 
+import heapq
 import math
 
 import numpy as np
@@ -10,9 +11,10 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from teamsim.controllers.navigation.astar import (SQRT2, CostMaps, PlannerParams, WeightAdaptation, adapt_weights,
-                                                  astar, cost_maps, cost_multiplier, distance_transform, modified_astar,
-                                                  plan_on_grid, probability_cost, reference_astar, window_mean)
+from teamsim.controllers.navigation.astar import (SQRT2, CostMaps, PlannerParams, WeightAdaptation, _heap_search,
+                                                  _padded, adapt_weights, astar, cost_maps, cost_multiplier,
+                                                  distance_transform, modified_astar, plan_on_grid, probability_cost,
+                                                  reference_astar, window_mean)
 from teamsim.controllers.navigation.occupancy_grid import OccupancyGrid
 
 FREE, WALL = 0.05, 0.95
@@ -246,3 +248,55 @@ def test_batched_search_matches_the_reference_on_larger_grids(seed):
 def test_unknown_heuristic_is_refused():
     with pytest.raises(ValueError, match="heuristic"):
         astar(CostMaps(np.zeros((2, 2), bool), np.ones((2, 2))), (0, 0), (1, 1), heuristic="chebyshev")
+
+
+# ---------------------------------------------------------------- the compiled heap search against plain Python
+
+
+def python_heap_search(grid):
+    """The thesis heuristics' search as the plain Python loop it was before it was compiled: (g, parent, closed,
+    expansions)."""
+    done = grid.blocked.tolist()
+    g = [math.inf] * len(done)
+    parent = [-1] * len(done)
+    g[grid.source] = 0.0
+    heap = [(grid.h[grid.source], grid.source)]
+    expanded = 0
+    while heap:
+        _, node = heapq.heappop(heap)
+        if done[node]:
+            continue
+        done[node] = True
+        expanded += 1
+        if node == grid.target:
+            break
+        moves = [(move, grid.multiplier[node + move], True) for move in grid.straight]
+        moves += [(move, SQRT2 * grid.multiplier[node + move], not (grid.blocked[node + a] or grid.blocked[node + b]))
+                  for move, a, b in grid.diagonal]
+        for move, step, allowed in moves:
+            nb = node + move
+            if allowed and not done[nb] and g[node] + step < g[nb]:
+                g[nb], parent[nb] = g[node] + step, node
+                heapq.heappush(heap, (g[nb] + grid.h[nb], nb))
+    return np.array(g), np.array(parent), np.array(done), expanded
+
+
+@pytest.mark.parametrize("heuristic", ["manhattan", "euclidean"])
+def test_compiled_heap_search_expands_as_the_python_loop(heuristic):
+    # Uniform grids among them, where many cells tie on f and the order of the heap's tuples decides.
+    rng = np.random.default_rng(31)
+    for case in range(200):
+        rows, cols = rng.integers(2, 45, 2)
+        density = rng.uniform(0.0, 0.4)
+        p = np.where(rng.random((rows, cols)) < density, WALL, rng.uniform(0.05, 0.6, (rows, cols)))
+        if case % 4 == 0:
+            p = np.where(p == WALL, WALL, FREE)
+        start, goal = ((int(rng.integers(rows)), int(rng.integers(cols))) for _ in range(2))
+        params = PlannerParams(heuristic=heuristic, weight_unexplored=0.3, weight_critical=0.2)
+        grid = _padded(cost_maps(p, params, inflation_cells=rng.choice([0.0, 1.5])), start, goal, heuristic)
+        g, parent, closed, expanded = _heap_search(grid)
+        ref_g, ref_parent, ref_closed, ref_expanded = python_heap_search(grid)
+        np.testing.assert_array_equal(g, ref_g)
+        np.testing.assert_array_equal(parent, ref_parent)
+        np.testing.assert_array_equal(closed, ref_closed)
+        assert expanded == ref_expanded

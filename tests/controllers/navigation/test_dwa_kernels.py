@@ -1,5 +1,6 @@
 """The dynamic window's compiled loops (dwa_kernels, through DynamicWindow's methods) against the plain Python
-loops of reference_dwa, one candidate at a time, on random scenes: the same DC_cd and the same ST_v."""
+loops of reference_dwa, one candidate at a time, on random scenes: the same DC_cd and the same ST_v; and HRDU's
+compiled re-planning test against the numpy form it replaced."""
 from __future__ import annotations
 
 import math
@@ -9,6 +10,7 @@ import pytest
 
 from teamsim.controllers.navigation import dwa_kernels as kernels
 from teamsim.controllers.navigation.dynamic_window import DynamicWindow
+from teamsim.controllers.navigation.occupancy_grid import OccupancyGrid
 from teamsim.controllers.navigation.reference_dwa import _braking_steps, _collision_distance, _stops_clear
 from teamsim.models.robot import DriveLimits
 
@@ -76,3 +78,35 @@ def test_memory_thinning_keeps_the_first_point_of_every_cell_as_np_unique_does()
         np.testing.assert_array_equal(got, expected)
         kept, seen = kept + len(got), seen + len(world)
     assert kept < 0.9 * seen  # the scenes do have points to thin
+
+
+def numpy_path_blocked(probabilities, ahead, origin, resolution, reach, threshold):
+    """HRDU's re-planning test as numpy arrays, as it was before it was compiled: the oracle."""
+    g = OccupancyGrid(origin, resolution, probabilities)
+    g.probabilities = probabilities  # unclamped, as given
+    rows, cols = g.world_to_cell(ahead[:, 0], ahead[:, 1])
+    margin = int(math.ceil(reach / resolution))
+    r0, c0 = max(int(rows.min()) - margin, 0), max(int(cols.min()) - margin, 0)
+    window = probabilities[r0:int(rows.max()) + margin + 1, c0:int(cols.max()) + margin + 1]
+    occupied_rows, occupied_cols = np.nonzero(window >= threshold)
+    if occupied_rows.size == 0:
+        return False
+    x, y = g.cell_to_world(occupied_rows + r0, occupied_cols + c0)
+    return bool((np.hypot(x[:, None] - ahead[:, 0], y[:, None] - ahead[:, 1]) <= reach).any())
+
+
+def test_path_blocked_matches_the_numpy_form():
+    # Paths on and off the grid (far beyond its edges too) and thresholds that some cells meet exactly.
+    rng, blocked = np.random.default_rng(14), 0
+    for _ in range(3000):
+        shape = tuple(rng.integers(1, 30, 2))
+        resolution = float(rng.choice([0.1, 0.3, rng.uniform(0.05, 0.5)]))
+        origin = tuple(rng.uniform(-2.0, 2.0, 2))
+        probabilities = np.round(rng.uniform(0.0, 1.0, shape), 1)
+        centre = np.array(origin) + rng.uniform(-1.0, 2.0, 2) * np.array(shape[::-1]) * resolution
+        ahead = centre + np.cumsum(rng.normal(0.0, resolution, (int(rng.integers(1, 21)), 2)), axis=0)
+        reach, threshold = float(rng.uniform(0.0, 1.0)), float(rng.choice([0.7, 0.9, 1.0]))
+        expected = numpy_path_blocked(probabilities, ahead, origin, resolution, reach, threshold)
+        assert kernels.path_blocked(probabilities, ahead, *origin, resolution, reach, threshold) == expected
+        blocked += expected
+    assert 300 < blocked < 2700  # both answers are tested

@@ -520,6 +520,24 @@ def test_hrdu_maps_replans_and_reaches_the_goal():
     assert controller.replans >= 1
 
 
+def test_hrdu_keeps_the_evidence_it_mapped_for_another_grid_of_its_frame():
+    world = random_world(0.05, np.random.default_rng(WORLD_SEED))
+    controller = HRDU(LIMITS, "diffdrive", 0.35, world.goal, grid=world.unexplored_map(),
+                      sensor_radius=np.linspace(0.3, 0.35, 10))
+    assert controller.last_evidence is None
+    bearings = np.linspace(-math.pi, math.pi, 10, endpoint=False)
+    ranges = np.where(np.arange(10) % 3 == 0, 0.8, np.inf)
+    obs = observation(2.5, pose=(world.start[0], world.start[1], 0.3), ranges=ranges, bearings=bearings)
+    controller(obs)
+    evidence = controller.last_evidence
+    assert evidence.time == 2.5 and evidence.pose == controller.pose_estimate
+    outgoing, expected = world.unexplored_map(), world.unexplored_map()
+    outgoing.apply(evidence)
+    expected.update(evidence.pose, ranges, bearings, sensor_radius=controller.sensor_radius, footprint_radius=0.35)
+    np.testing.assert_array_equal(outgoing.probabilities, controller.grid.probabilities)
+    np.testing.assert_array_equal(outgoing.probabilities, expected.probabilities)
+
+
 def test_every_variant_drives_without_error():
     world = random_world(0.05, np.random.default_rng(WORLD_SEED))
     for controller_class in (RFRC, ODW, ODWDS):

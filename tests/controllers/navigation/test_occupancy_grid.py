@@ -1,5 +1,6 @@
 """Unit tests for the occupancy grid (Chand §3.2.1, §6.2.2, eq. 6.3-6.5): frames, the sensor model, Bayes'
-rule, clamping and the IR beam update."""
+rule, clamping and the IR beam update; the compiled update against the numpy form it replaced, bit for bit, and a
+reading's evidence shared between grids."""
 from __future__ import annotations
 
 import math
@@ -7,7 +8,7 @@ import math
 import numpy as np
 import pytest
 
-from teamsim.controllers.navigation.occupancy_grid import (MappingParams, OccupancyGrid, bayes_update,
+from teamsim.controllers.navigation.occupancy_grid import (MappingParams, OccupancyGrid, _numpy_sum, bayes_update,
                                                            p_free_given_free, p_occupied_given_occupied, sensor_noise)
 
 PARAMS = MappingParams()
@@ -178,3 +179,113 @@ def test_robot_outside_the_grid_changes_nothing():
     g = grid()
     g.update((50.0, 50.0, 0.0), np.array([1.0]), np.array([0.0]), sensor_radius=0.2)
     assert np.all(g.probabilities == 0.5)
+
+
+# ---------------------------------------------------------------- evidence, apply, and the compiled loop
+
+
+def numpy_update(g, pose, ranges, bearings, *, sensor_radius, centre_offset=0.0, footprint_radius=0.0):
+    """The update as numpy arrays over (beams, rows, cols), as it was before it was compiled: the oracle."""
+    def logit(q):
+        return np.log(q / (1.0 - q))
+
+    p = g.params
+    x, y, heading = (float(v) for v in pose)
+    ranges, bearings = np.asarray(ranges, float), np.asarray(bearings, float)
+    cx, cy = x + centre_offset * np.cos(heading), y + centre_offset * np.sin(heading)
+    ux, uy = np.cos(heading + bearings), np.sin(heading + bearings)
+    sx, sy = cx + sensor_radius * ux, cy + sensor_radius * uy
+    rows, cols = g.window(cx, cy, float(np.max(sensor_radius)) + p.range_max + g.resolution)
+    if rows.size == 0 or cols.size == 0:
+        return
+    wx, wy = g.cell_to_world(rows[:, None], cols[None, :])
+    dx, dy = wx[None] - sx[:, None, None], wy[None] - sy[:, None, None]
+    along = dx * ux[:, None, None] + dy * uy[:, None, None]
+    across = np.abs(dx * uy[:, None, None] - dy * ux[:, None, None])
+    half_width = np.maximum(along * np.tan(p.beam_angle / 2), g.resolution / 2)
+    in_beam = (along > 0) & (across <= half_width) & (along <= p.range_max)
+    hit = np.isfinite(ranges) & (ranges < p.range_max)
+    measured = np.where(hit, ranges, p.range_max)[:, None, None]
+    if p.hit_cell == "beyond":
+        free = in_beam & (along < measured)
+        occupied = in_beam & hit[:, None, None] & (along >= measured) & (along < measured + g.resolution)
+    else:
+        free = in_beam & (along < measured - g.resolution / 2)
+        occupied = in_beam & hit[:, None, None] & (np.abs(along - measured) <= g.resolution / 2)
+    q_free = p_free_given_free(along, p)
+    q_occ = p_occupied_given_occupied(sensor_noise(measured, p), g.resolution, g.resolution)
+    evidence = (np.where(free & (q_free < 0.5), logit(q_free), 0.0).sum(axis=0)
+                + np.where(occupied & (q_occ > 0.5), logit(q_occ), 0.0).sum(axis=0))
+    if footprint_radius > 0:
+        evidence += np.where(np.hypot(wx - cx, wy - cy) <= footprint_radius, logit(np.asarray(p.p_free_near)), 0.0)
+    block = np.ix_(rows, cols)
+    posterior = 1.0 / (1.0 + np.exp(-(logit(g.probabilities[block]) + evidence)))
+    g.probabilities[block] = np.clip(posterior, p.p_min, p.p_max)
+
+
+def random_reading(rng):
+    """A grid (random frame, parameters and probabilities), and a reading on it: (grid, pose, ranges, bearings,
+    keyword arguments). Some robots stand off the grid, some grids are a single cell (numpy then sums a cell's
+    beams pairwise), and some readings have many beams."""
+    params = MappingParams(beam_angle=np.radians(rng.uniform(2.0, 12.0)), range_min=rng.choice([0.0, 0.05]),
+                           range_max=rng.uniform(0.8, 2.0), p_free_near=rng.uniform(0.1, 0.3),
+                           p_free_far=rng.uniform(0.4, 0.6), noise_min=rng.uniform(0.0, 0.01),
+                           noise_max=rng.uniform(0.01, 0.05), hit_cell=rng.choice(["around", "beyond"]))
+    resolution = rng.choice([0.1, 0.3, rng.uniform(0.05, 0.5)])
+    shape = (1, 1) if rng.random() < 0.1 else tuple(rng.integers(1, 40, 2))
+    origin = tuple(rng.uniform(-3.0, 3.0, 2))
+    g = OccupancyGrid(origin, resolution, rng.uniform(0.05, 0.95, shape), params)
+    size = np.array(shape[::-1]) * resolution
+    x, y = np.array(origin) + rng.uniform(-0.5, 1.5, 2) * size
+    beams = int(rng.choice([0, 1, 5, 8, 11, 14, 20, 150]))
+    ranges = rng.uniform(0.0, 1.2 * params.range_max, beams)
+    ranges[rng.random(beams) < 0.3] = np.inf
+    ranges[rng.random(beams) < 0.05] = params.range_max
+    radius = rng.uniform(0.0, 0.6, beams) if rng.random() < 0.5 and beams else rng.uniform(0.0, 0.6)
+    kwargs = dict(sensor_radius=radius, centre_offset=rng.choice([0.0, rng.uniform(-0.3, 0.3)]),
+                  footprint_radius=rng.choice([0.0, rng.uniform(0.1, 0.6)]))
+    return g, (x, y, rng.uniform(-np.pi, np.pi)), ranges, rng.uniform(-np.pi, np.pi, beams), kwargs
+
+
+def test_compiled_update_is_the_numpy_update_bit_for_bit():
+    rng, changed, single = np.random.default_rng(21), 0, 0
+    for _ in range(1500):
+        g, pose, ranges, bearings, kwargs = random_reading(rng)
+        expected = OccupancyGrid(g.origin, g.resolution, g.probabilities.copy(), g.params)
+        numpy_update(expected, pose, ranges, bearings, **kwargs)
+        before = g.probabilities.copy()
+        g.update(pose, ranges, bearings, **kwargs)
+        np.testing.assert_array_equal(g.probabilities, expected.probabilities)
+        changed += not np.array_equal(before, g.probabilities)
+        single += g.shape == (1, 1) and len(ranges) >= 8 and not np.array_equal(before, g.probabilities)
+    assert changed > 900 and single > 10  # the readings do map something, single cells with many beams among them
+
+
+def test_numpy_sum_is_numpys_pairwise_summation():
+    rng = np.random.default_rng(22)
+    for n in list(range(40)) + [127, 128, 129, 130, 200, 255, 256, 257, 300, 1000]:
+        values = rng.normal(0.0, 1.0, n) * 10.0 ** rng.uniform(-3, 3, n)
+        assert _numpy_sum(values) == values.reshape(-1, 1, 1).sum(axis=0)[0, 0]
+
+
+def test_evidence_leaves_the_grid_and_applies_to_any_grid_of_its_frame():
+    a, b = grid(), grid()
+    b.probabilities[:] = np.random.default_rng(23).uniform(0.05, 0.95, b.shape)
+    expected = OccupancyGrid(b.origin, b.resolution, b.probabilities.copy())
+    reading = ((0.3, -0.2, 0.4), np.array([1.0, np.inf, 0.6]), np.array([0.0, 1.0, -1.0]))
+    kwargs = dict(sensor_radius=np.array([0.2, 0.25, 0.3]), centre_offset=0.1, footprint_radius=0.3)
+    evidence = a.evidence(*reading, **kwargs)
+    assert np.all(a.probabilities == 0.5)
+    assert evidence.pose == (0.3, -0.2, 0.4) and evidence.frame == a.frame
+    assert a.probabilities[evidence.rows, evidence.cols].shape == evidence.log_odds.shape
+    b.apply(evidence)
+    expected.update(*reading, **kwargs)
+    np.testing.assert_array_equal(b.probabilities, expected.probabilities)
+
+
+def test_evidence_of_another_frame_is_refused():
+    evidence = grid().evidence((0.0, 0.0, 0.0), np.array([1.0]), np.array([0.0]), sensor_radius=0.2)
+    for other in (grid(resolution=0.2), grid(origin=(-3.0, -3.05)), grid(shape=(60, 61)),
+                  OccupancyGrid.unexplored((-3.05, -3.05), 0.1, (60, 60), MappingParams(hit_cell="beyond"))):
+        with pytest.raises(ValueError, match="evidence"):
+            other.apply(evidence)

@@ -89,3 +89,20 @@ def test_near_ties_keep_the_previous_side():
     assert kept == pytest.approx(-free_choice)
     # A clearly better direction still wins over the previous one.
     assert modified_target_heading(np.zeros((0, 2)), 0.0, 0.35, previous=1.0) == 0.0
+
+
+def test_cached_candidates_give_the_heading_of_freshly_computed_ones():
+    rng = np.random.default_rng(5)
+    for _ in range(300):
+        params = DirectionSensorParams(directions=int(rng.choice([8, 41, 72])))
+        points = rng.uniform(-2.0, 2.0, (int(rng.integers(0, 40)), 2))
+        target, previous = rng.uniform(-math.pi, math.pi), rng.choice([None, rng.uniform(-math.pi, math.pi)])
+        directions = candidate_directions(params.directions)
+        distances = obstacle_distances(points, directions, 0.35, params.max_distance)
+        scores = direction_objective(directions, target, smooth(distances, params.smoothing), params)
+        if previous is None:
+            expected = directions[np.argmax(scores)]
+        else:
+            ties = np.flatnonzero(scores >= scores.max() - params.tie_tolerance)
+            expected = directions[ties[np.argmin(np.abs(wrap(directions[ties] - previous)))]]
+        assert modified_target_heading(points, target, 0.35, params, previous) == expected
