@@ -35,7 +35,8 @@ class PlannerParams:
     negotiation: float = 0.5  # s to wait for the other planners' proposals (not given; a few radio round trips)
     memories: int = 2  # Q, local-map memories of the two-tiered A* (§4.6 tests 1, 5 and 15)
     blocked: float = 0.95  # occupancy written over environments the path must avoid
-    bog_reach: float = 2.0  # m round a reported bog that a wheeled explorer's path keeps out of (not given)
+    bog_reach: float = 3.0  # m round a reported bog that a wheeled explorer's path keeps out of (not given; bogs
+    # are 3.6-6 m across and are found at their edge)
 
 
 @dataclass
@@ -165,7 +166,7 @@ class Planner:
         for e in avoid - {environment, start_environment}:
             global_map[territory.slices(e)] = np.maximum(global_map[territory.slices(e)], self.params.blocked)
         if not explorer.bog_capable:
-            self._block_bogs(global_map, job["bog_points"])
+            self._block_bogs(global_map, job["bog_points"], explorer, job["radius"])
         start, goal = territory.cell_of(*explorer.position), territory.cell_of(*territory.centre(environment))
         radius_cells = max(1, math.ceil(job["radius"] / territory.resolution))
         result = two_tier_astar(global_map, start, goal, territory.partition,
@@ -182,13 +183,16 @@ class Planner:
                   at=now + result.transmission_time)
         self.send("job-done", {"job_id": job["job_id"]}, to=self.manager, at=now + result.transmission_time)
 
-    def _block_bogs(self, global_map: np.ndarray, points) -> None:
+    def _block_bogs(self, global_map: np.ndarray, points, explorer: ExplorerState, radius: float) -> None:
         """Cells within ``bog_reach`` of a reported bog are impassable for a wheeled explorer, even in the
-        environment it starts from, which the per-environment terrain map cannot keep it out of."""
+        environment it starts from, which the per-environment terrain map cannot keep it out of; never the cells
+        round the explorer itself (a robot just backed out of a bog stands nearer than that), so it can leave."""
         territory = self.territory
-        reach = round(self.params.bog_reach / territory.resolution)
+        centres = territory.origin[0] + (np.arange(territory.cells) + 0.5) * territory.resolution
+        x_cells, y_cells = np.meshgrid(centres, territory.origin[1] + (np.arange(territory.cells) + 0.5)
+                                       * territory.resolution)
         for x, y in points:
-            row, col = territory.cell_of(x, y)
-            rows = slice(max(row - reach, 0), row + reach + 1)
-            cols = slice(max(col - reach, 0), col + reach + 1)
-            global_map[rows, cols] = np.maximum(global_map[rows, cols], self.params.blocked)
+            reach = min(self.params.bog_reach, math.dist((x, y), explorer.position) - radius)
+            if reach > 0:
+                inside = np.hypot(x_cells - x, y_cells - y) <= reach
+                global_map[inside] = np.maximum(global_map[inside], self.params.blocked)
