@@ -291,7 +291,7 @@ class Explorer:
     def _enter_bog(self, obs, pose) -> tuple[float, float, str]:
         environment = self.territory.environment_of(pose[0], pose[1])
         self.send("bog", {"environment": environment, "position": (pose[0], pose[1])})
-        self.bog = _Bog(self.slow_since, self._before_bog(self.slow_since), [(pose[0], pose[1])])
+        self.bog = _Bog(self.slow_since, self._before_bog(self.slow_since, pose), [(pose[0], pose[1])])
         if self.bog_capable:
             return self._drive(obs, pose)
         self.state = "back-out"
@@ -299,9 +299,9 @@ class Explorer:
         self.stalled_since = None
         return self._back_out(obs, pose)
 
-    def _before_bog(self, entered: float) -> tuple[float, float]:
+    def _before_bog(self, entered: float, pose) -> tuple[float, float]:
         """Where to reverse to: the point of the robot's own trail ``back_out_distance`` short of where the bog
-        slowed it (or the trail's start)."""
+        slowed it; straight back that far if the trail does not lead away (a robot that has stood still)."""
         trail = [(t, x, y) for t, x, y in self.trail if t <= entered] or list(self.trail)[:1]
         _, x, y = trail[-1]
         travelled = 0.0
@@ -310,6 +310,9 @@ class Explorer:
             x, y = px, py
             if travelled >= self.params.back_out_distance:
                 break
+        if math.dist((x, y), pose[:2]) < self.params.back_out_distance / 2:
+            x = pose[0] - self.params.back_out_distance * math.cos(pose[2])
+            y = pose[1] - self.params.back_out_distance * math.sin(pose[2])
         return x, y
 
     def _back_out(self, obs, pose) -> tuple[float, float, str]:
@@ -339,9 +342,8 @@ class Explorer:
         self.nav.grid.probabilities[rows, cols] = 0.5
         self.outgoing.probabilities[rows, cols] = 0.5
         self.send("reset", {"rows": rows, "cols": cols}, size=SMALL_MESSAGE + 8 * len(rows))
-        self.send("request", {"kind": "environment", "position": self.bog.mapped_from[-1],
-                              "bog_capable": False, "give_up": self.assignment.environment if self.assignment
-                              else None})
+        self.send("request", {"kind": "environment", "position": self.bog.mapped_from[-1], "bog_capable": False,
+                              "give_up": self.assignment.environment if self.assignment else None, "bog": True})
         self.bog = None
         self.slow_since = None
         self.assignment = None

@@ -28,6 +28,7 @@ from teamsim.network import Packet
 
 SMALL_MESSAGE = 64
 EXPLORER, PLANNER = "W2", "W1"  # the worker tasks of Table 5.20
+BOG_TURNS = 2  # a wheeled explorer turned back by bogs this often on its way to an environment gives it up
 
 
 @dataclass
@@ -37,6 +38,7 @@ class ExplorerRecord:
     radius: float
     environment: int | None = None
     excluded: set = field(default_factory=set)  # PE environments it explored (§6.4.2), ones it gave up
+    bog_turns: dict = field(default_factory=dict)  # environment -> times a bog turned it back on the way there
     started: float | None = None  # s, first assignment
     explored_cells: float = 0.0  # from its reports, for ECT's A_o
 
@@ -86,7 +88,10 @@ class GlobalInfo:
         given_up = payload.get("give_up")
         if payload["kind"] == "environment" and given_up is not None:
             self._release(given_up, sender, now)
-            record.excluded.add(given_up)  # it could not get there (or out of its bog): not this robot again
+            # Not this robot again: it could not get there, or a bog turned it back twice on the way.
+            record.bog_turns[given_up] = record.bog_turns.get(given_up, 0) + bool(payload.get("bog"))
+            if not payload.get("bog") or record.bog_turns[given_up] >= BOG_TURNS:
+                record.excluded.add(given_up)
             record.environment = None
         self.queue.request(sender, payload["kind"])
 
