@@ -43,6 +43,7 @@ class ExplorerParams:
     bog_effort: float = 0.25  # drive effort (share of the motors' limit) that is "abnormally high" (measured in
     # physics: at most 0.09 on firm ground, accelerating; in a bog 0.3 (tracked, full speed) to 1.0 (diffdrive)) ...
     bog_speed: float = 0.002  # ... while the robot still creeps (m/s; stalled against a box it reads 0) ...
+    bog_turn: float = 0.1  # ... and hardly turns (rad/s; a tracked robot's skid turn takes up to 0.8 effort) ...
     bog_time: float = 1.5  # ... for this long: a bog
     back_out_limit: float = 60.0  # s of reversing at most; it also stops when something behind stalls it
     back_out_distance: float = 2.0  # m of its own trail to reverse beyond where the bog slowed it
@@ -274,13 +275,13 @@ class Explorer:
 
     # -- bogs ---------------------------------------------------------------------------------------------------
     def _bogged(self, obs) -> bool:
-        """Abnormally high drive effort while moving, held for ``bog_time`` (§6.2's PWM effort at low velocity: a
-        wheeled robot creeps, a tracked one keeps its speed at full effort; a stall against a box, at zero speed,
-        is not a bog)."""
+        """Abnormally high drive effort while moving and hardly turning, held for ``bog_time`` (§6.2's PWM effort
+        at low velocity: a wheeled robot creeps, a tracked one keeps its speed at high effort; a stall against a
+        box, at zero speed, is not a bog, nor is a tracked robot's skid turn)."""
         p = self.params
         effort = obs.drive_effort
         slow = (effort is not None and obs.velocity is not None and effort >= p.bog_effort
-                and abs(obs.velocity[0]) >= p.bog_speed)
+                and abs(obs.velocity[0]) >= p.bog_speed and abs(obs.velocity[1]) <= p.bog_turn)
         if not slow:
             self.slow_since = None
             return False
