@@ -220,3 +220,21 @@ def test_drive_effort_is_high_in_a_bog_and_only_there(kind, cruise):
 
     assert len(firm) >= 20 and longest_high_run(firm) < 15 and max(firm) < 0.25
     assert longest_high_run(boggy) >= 15
+
+
+@pytest.mark.parametrize("v, omega", [(0.0, 0.45), (0.2, 0.45), (0.4, 0.2)])
+def test_a_tracked_skid_turn_is_hard_work_but_not_a_bog(v, omega):
+    """A tracked robot turning on firm ground scrubs its tracks: its effort passes 0.25 (the bog sign), but only
+    while it turns faster than 0.1 rad/s, which the explorers' bog test excludes (decisions.md, "Exploration")."""
+    world, red = solo("tracked", lambda o: (v, omega), x=-2.0)
+    readings = []
+    for _ in range(60):
+        run_for(world, 0.1)
+        observation = world.controllers["red"].observations[-1]
+        readings.append((observation.drive_effort, abs(observation.velocity[1])))
+    assert max(effort for effort, _ in readings) >= 0.25, "turning is hard work"
+    run = longest = 0
+    for effort, turn in readings:  # the bog test: 15 ticks (1.5 s) running of high effort while hardly turning
+        run = run + 1 if effort >= 0.25 and turn <= 0.1 else 0
+        longest = max(longest, run)
+    assert longest < 15
