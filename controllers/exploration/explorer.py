@@ -24,12 +24,11 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from teamsim.controllers.exploration.territory import Territory
+from teamsim.controllers.exploration.territory import SMALL_MESSAGE, Territory
 from teamsim.controllers.exploration.waypoints import WaypointParams, coverage_waypoints
 from teamsim.controllers.navigation.dynamic_window import HRDU
 from teamsim.network import Packet
 
-SMALL_MESSAGE = 64  # bytes of a request, report or notice: a few doubles and a header
 TRAIL_TICKS = 1200  # the last two minutes of poses at 10 Hz
 
 

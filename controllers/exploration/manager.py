@@ -23,10 +23,9 @@ from teamsim.controllers.allocation.feedback_coordination import FeedbackCoordin
 from teamsim.controllers.exploration.assignment import ExplorerState
 from teamsim.controllers.exploration.global_map import EXPLORED_THRESHOLD, environment_status, explored_fraction, merge
 from teamsim.controllers.exploration.job_queue import JobQueue
-from teamsim.controllers.exploration.territory import Territory
+from teamsim.controllers.exploration.territory import SMALL_MESSAGE, Territory
 from teamsim.network import Packet
 
-SMALL_MESSAGE = 64
 EXPLORER, PLANNER = "W2", "W1"  # the worker tasks of Table 5.20
 BOG_TURNS = 2  # a wheeled explorer turned back by bogs this often on its way to an environment gives it up
 

@@ -22,11 +22,10 @@ import numpy as np
 from teamsim.controllers.exploration.assignment import (ExplorerState, Proposal, candidate_environments,
                                                         mutual_exclusion, propose)
 from teamsim.controllers.exploration.job_queue import ect_acceptable, estimated_completion_time
-from teamsim.controllers.exploration.territory import Territory
+from teamsim.controllers.exploration.territory import SMALL_MESSAGE, Territory
 from teamsim.controllers.navigation.two_tier_astar import TwoTierParams, two_tier_astar
 from teamsim.network import Packet
 
-SMALL_MESSAGE = 64
 PATH_NODE_BYTES = 16  # one (x, y) pair of doubles
 
 

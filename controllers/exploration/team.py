@@ -14,6 +14,7 @@ from teamsim.controllers.base import Command, Observation
 from teamsim.controllers.exploration.explorer import Explorer
 from teamsim.controllers.exploration.manager import EXPLORER, PLANNER, FeedbackSystem, GlobalInfo
 from teamsim.controllers.exploration.planner import Planner
+from teamsim.controllers.exploration.territory import SMALL_MESSAGE
 from teamsim.network import Packet
 
 REPORT_LEAD = 1.0  # s before each T_m boundary that a worker reports, so the report is in when the monitor runs
@@ -92,9 +93,9 @@ class TeamRobot:
             tasks[PLANNER] = self.planner.report()
         if tasks:
             payload = {"tasks": tasks, "position": self.position}
-            self._outgoing.append(Packet("report", payload, 64, self.addresses.feedback))
+            self._outgoing.append(Packet("report", payload, SMALL_MESSAGE, self.addresses.feedback))
             if self.addresses.manager != self.addresses.feedback:
-                self._outgoing.append(Packet("report", payload, 64, self.addresses.manager))
+                self._outgoing.append(Packet("report", payload, SMALL_MESSAGE, self.addresses.manager))
 
     def _collect(self, now: float) -> list[Packet]:
         """Every role's outbox; what is for this robot (addressed to it, or broadcast) is delivered here at once,

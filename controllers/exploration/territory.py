@@ -15,6 +15,9 @@ from teamsim.controllers.navigation.occupancy_grid import MappingParams, Occupan
 from teamsim.controllers.navigation.two_tier_astar import Partition, partition_global_map
 
 
+SMALL_MESSAGE = 64  # bytes on the link of a request, report or notice: a few doubles and a header
+
+
 @dataclass(frozen=True)
 class Territory:
     size: float  # m, side of the square global area

@@ -208,7 +208,7 @@ class ExploreMission(ScenarioMission):
             raise ConfigError(f"arena.size=[{sx:g}, {sy:g}]: explore's worlds are square; allowed: equal sides")
         task = scenario.task
         ExploreWorldParams(size=sx, resolution=task.resolution, divisions=task.divisions).check()
-        team_allocation(list(scenario.robots), task.planners, task.explorers)
+        scenario_allocation(scenario)
 
     def scene(self, scenario: Scenario, newcomers, physics_dt: float) -> Scene:
         scene = scene_of(scenario, newcomers, physics_dt)
@@ -222,8 +222,8 @@ class ExploreMission(ScenarioMission):
 
     def done(self, world) -> bool:
         info = world.scene.info
-        positions = {r.name: world.pose(r)[:2] for r in world.robots.values() if r.active}
-        sample_progress(info, world.time, positions)
+        sample_progress(info, world.time,
+                        lambda: {r.name: world.pose(r)[:2] for r in world.robots.values() if r.active})
         return exploration_over(info)
 
     def write_outputs(self, world, run_dir: Path) -> None:
@@ -231,9 +231,7 @@ class ExploreMission(ScenarioMission):
 
     def fault_targets(self, scenario: Scenario, faults: list) -> list:
         """Faults may name a robot by its role: manager, feedback, planner, explorer, plannerN, explorerN."""
-        task = scenario.task
-        return fault_targets(faults, team_allocation(list(scenario.robots), task.planners, task.explorers),
-                             list(scenario.robots))
+        return fault_targets(faults, scenario_allocation(scenario), list(scenario.robots))
 
     def video_panel(self, world) -> np.ndarray | None:
         """The manager's global map as it grows, beside the top-down view: redrawn every ``PANEL_PERIOD`` s."""
@@ -285,6 +283,11 @@ def fault_targets(faults, allocation: Allocation, robots: list[str]) -> list:
     return out
 
 
+def scenario_allocation(scenario: Scenario) -> Allocation:
+    """The devolution over a scenario's robots, in its task's quantities."""
+    return team_allocation(list(scenario.robots), scenario.task.planners, scenario.task.explorers)
+
+
 def team_members(allocation: Allocation) -> set[str]:
     return set(allocation.managers.values()) | {r for robots in allocation.workers.values() for r in robots}
 
@@ -294,7 +297,7 @@ def team_setup(scenario: Scenario) -> dict:
     the true world, and a slot for the manager's state."""
     task = scenario.task
     specs = {r.id: r for r in load_robots()}
-    allocation = team_allocation(list(scenario.robots), task.planners, task.explorers)
+    allocation = scenario_allocation(scenario)
     territory = Territory(scenario.arena.size[0], task.resolution, task.divisions)
     truth = nav_world_of(dataclasses.replace(scenario, task=_RasterTask(task.resolution)))
     bogs = scenario.arena.bogs
@@ -367,8 +370,9 @@ TRAIL_PERIOD = 1.0  # s between samples of each robot's position, for map.png
 PANEL_PERIOD = 2.0  # s of simulated time between redraws of the video's map panel
 
 
-def sample_progress(info: dict, time: float, positions: dict) -> None:
-    """Now and then: the explored share (coverage.png) and each robot's position (map.png)."""
+def sample_progress(info: dict, time: float, positions) -> None:
+    """Now and then: the explored share (coverage.png) and each robot's position (map.png); ``positions()`` gives
+    the live robots' (x, y), read only when a sample is due."""
     samples = info.setdefault("coverage", [])
     global_info = info["team"].get("global_info")
     if global_info is not None and (not samples or time >= samples[-1][0] + COVERAGE_PERIOD):
@@ -376,7 +380,7 @@ def sample_progress(info: dict, time: float, positions: dict) -> None:
     trails = info.setdefault("trails", {})
     if time >= info.get("trail_time", -math.inf) + TRAIL_PERIOD:
         info["trail_time"] = time
-        for name, (x, y) in positions.items():
+        for name, (x, y) in positions().items():
             trails.setdefault(name, []).append((float(x), float(y)))
 
 
@@ -458,7 +462,8 @@ def kinematic_trial(config, duration: float | None = None) -> dict:
     duration = duration or config.duration
     while team.time < duration - 1e-9 and not exploration_over(info):
         team.tick()
-        sample_progress(info, team.time, {n: (m.body.x, m.body.y) for n, m in team.members.items() if m.alive})
+        sample_progress(info, team.time,
+                        lambda: {n: (m.body.x, m.body.y) for n, m in team.members.items() if m.alive})
     completed, metrics = exploration_outcome(info, team.time)
     return {"mission": "explore", "seed": config.seed, "run_id": config.run_id,
             "status": "completed" if completed else "failed", "completed": completed,
