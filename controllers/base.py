@@ -30,6 +30,7 @@ class Observation:
     inclination: tuple | None = None  # (roll, pitch) in rad, for robots with an inclinometer
     effectors: dict = field(default_factory=dict)  # effector -> position in [0, 1] from its encoder
     drive_effort: float | None = None  # mean share of the locomotion motors' force limit in use ("PWM effort")
+    signals: dict = field(default_factory=dict)  # the mission's own sensors (``Mission.sense``), e.g. sound detectors
 
 
 class TraceEvent(Protocol):

@@ -9,7 +9,7 @@ import importlib
 from teamsim.models.robot import RobotModel
 
 # Every robot kind teamsim knows by name, and the module whose ``build(name)`` makes it.
-ROBOT_KINDS = ("r2", "genghis2", "tricycle", "diffdrive", "tracked")
+ROBOT_KINDS = ("r2", "genghis2", "tricycle", "diffdrive", "tracked", "janitor")
 _MODULES = {kind: f"teamsim.models.{kind}" for kind in ROBOT_KINDS}
 
 

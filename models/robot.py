@@ -143,8 +143,8 @@ def polygon_rim(vertices: list[tuple[float, float]]) -> Callable[[float], float]
 
 
 def add_ir_ring(body: mjcf.Element, count: int, radius: float | Callable[[float], float], height: float,
-                max_range: float, first_bearing: float = 0.0,
-                centre: tuple[float, float] = (0.0, 0.0)) -> tuple[tuple[str, ...], np.ndarray]:
+                max_range: float, first_bearing: float = 0.0, centre: tuple[float, float] = (0.0, 0.0),
+                prefix: str = "ir") -> tuple[tuple[str, ...], np.ndarray]:
     """Rangefinder sites evenly spaced over 360 degrees at ``height``, looking outward from the body's rim.
 
     ``radius`` is the rim's distance from ``centre``: a number for a round body, or a function of bearing
@@ -155,10 +155,10 @@ def add_ir_ring(body: mjcf.Element, count: int, radius: float | Callable[[float]
         bearing = first_bearing + 2 * math.pi * k / count
         c, s = math.cos(bearing), math.sin(bearing)
         r = radius(bearing) if callable(radius) else radius
-        site = body.add("site", name=f"ir{k}", pos=[centre[0] + r * c, centre[1] + r * s, height], size=[0.01],
+        site = body.add("site", name=f"{prefix}{k}", pos=[centre[0] + r * c, centre[1] + r * s, height], size=[0.01],
                         zaxis=[c, s, 0], rgba=[1, 0.3, 0.3, 0.6], group=3)
-        root.sensor.add("rangefinder", name=f"ir{k}", site=site, cutoff=max_range)
-        names.append(f"ir{k}")
+        root.sensor.add("rangefinder", name=f"{prefix}{k}", site=site, cutoff=max_range)
+        names.append(f"{prefix}{k}")
         bearings.append(bearing)
     return tuple(names), np.asarray(bearings)
 

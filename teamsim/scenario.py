@@ -217,6 +217,10 @@ def _convert(path: str, kind: Any, value: Any, meta: dict, schema: dict) -> Any:
             raise ConfigError(f"{path}: expected {'true or false' if kind is bool else 'text'}, got {_show(value)}")
         check_value(path, value, meta)
         return value
+    if origin is tuple and len(args) == 2 and args[1] is Ellipsis:  # tuple[X, ...]: a list of any length
+        if not isinstance(value, list):
+            raise ConfigError(f"{path}: expected a list, got {_show(value)}")
+        return tuple(_convert(f"{path}[{k}]", args[0], v, meta, schema) for k, v in enumerate(value))
     if origin is tuple:
         if not isinstance(value, list) or len(value) != len(args):
             raise ConfigError(f"{path}: expected a list of {len(args)} numbers, got {_show(value)}")
@@ -665,9 +669,11 @@ def generate(config: TrialConfig, mission) -> Scenario:
     newcomers = [(f.robot, f.options["kind"]) for f in config.faults if f.kind == "add-robot"]
     world = mission.scenario(config.params, RandomStreams(config.seed).get("mission", "layout"), newcomers)
     default = getattr(mission, "duration_of", lambda params: mission.default_duration)(config.params)
+    # A mission may set the radio from its parameters (the janitorial mission's rho, Parker §6.2.3).
+    radio = getattr(mission, "radio_of", lambda params, radio: radio)(config.params, config.radio)
     scenario = dataclasses.replace(world, mission=config.mission, seed=config.seed,
                                    duration=config.duration or default, timing=config.timing,
-                                   radio=config.radio, positioning=config.positioning)
+                                   radio=radio, positioning=config.positioning)
     return load(to_data(scenario), mission)  # as a file would give it: plain floats, tuples, checked ranges
 
 

@@ -164,6 +164,7 @@ class World:
             self.radio.set_enabled(robot.name, robot.active)
         self.step = 0
         self._restarts = 0
+        self._sense = getattr(mission, "sense", None)  # a mission's own sensors: sense(world, robot) -> dict
         mujoco.mj_forward(self.model, self.data)
 
     # -- set-up ---------------------------------------------------------------------------------------------
@@ -310,7 +311,8 @@ class World:
             break_beams=(beams >= 0) & (beams < spec.beam_length),
             inclination=self.inclination(robot) if spec.inclinometer else None,
             effectors={name: self._effector_position(robot, name) for name in robot.effectors},
-            drive_effort=self._drive_effort(robot))
+            drive_effort=self._drive_effort(robot),
+            signals=self._sense(self, robot.name) if self._sense is not None else {})
         command: Command = robot.controller(observation)
         if not (math.isfinite(command.v) and math.isfinite(command.omega)):
             raise ValueError(f"controller of {robot.name} returned a non-finite command {command}")

@@ -283,12 +283,17 @@ class AllianceRobot:
     feedback of each behaviour set, the radio messages received since the last step and the teammates
     present; it returns the active set (or None) and a :class:`StepTrace`."""
 
-    def __init__(self, name: str, behaviour_sets: Sequence[BehaviourSet], params: AllianceParams = AllianceParams()):
+    def __init__(self, name: str, behaviour_sets: Sequence[BehaviourSet], params: AllianceParams = AllianceParams(),
+                 precedes: Callable[[str, str], bool] | None = None):
         names = [s.name for s in behaviour_sets]
         if not names or len(set(names)) != len(names):
             raise ConfigError(f"robot {name}: behaviour set names must be unique and at least one: {names}")
         self.name = name
         self.params = params
+        # precedes(task, k): whether teammate k's claim on the task came before this robot's, so that psi yields
+        # to it; None: psi yields to any claimant (§3.6). A mission whose robots start a sub-task together needs
+        # the order, or both yield at once and meet again (docs/decisions.md, "Janitorial service").
+        self.precedes = precedes
         self.sets = tuple(behaviour_sets)
         self.tasks = tuple(dict.fromkeys(s.task for s in self.sets))
         self.log = CommunicationLog(self.tasks, params)
@@ -381,7 +386,7 @@ class AllianceRobot:
             if is_active and acquiescence:
                 r = rates[name] if rates is not None else s.rates
                 held = time - self.active_since
-                if held > r.psi and claimants(s.task):
+                if held > r.psi and self._yields(s.task, claimants(s.task)):
                     gave_up = "psi"
                 elif held > r.lam:
                     gave_up = "lambda"
@@ -408,6 +413,12 @@ class AllianceRobot:
         self._hold_rates(time, theta, feedback, rates, gates, growth_override, claimants, events)
         trace = StepTrace(time, theta, self.active, dict(self.motivation), dict(self.growth), zeroed, tuple(events))
         return self.active, trace
+
+    def _yields(self, task: str, claimants: list[str]) -> bool:
+        """Whether psi would yield to one of the teammates claiming ``task``."""
+        if self.precedes is None:
+            return bool(claimants)
+        return any(self.precedes(task, k) for k in claimants)
 
     def _select(self, time: float, theta: float, zeroed: dict, events: list) -> None:
         """An idle robot activates its highest-priority set above theta; the others are suppressed at once."""
@@ -436,7 +447,7 @@ class AllianceRobot:
             r = rates[name] if rates is not None else s.rates
             if name == active:
                 next_event = min(next_event, self.active_since + r.lam)
-                if claimants(s.task):
+                if self._yields(s.task, claimants(s.task)):
                     next_event = min(next_event, self.active_since + r.psi)
             if growth_override is not None:
                 growth = growth_override[name]
