@@ -38,6 +38,7 @@ FREQUENCY_RGBA = [(0.9, 0.2, 0.2, 1), (0.2, 0.5, 0.95, 1), (0.95, 0.8, 0.1, 1), 
 EMPTIED_RGBA, DUSTED_RGBA, FURNITURE_RGBA = (0.55, 0.55, 0.55, 1), (0.95, 0.9, 0.75, 1), (0.55, 0.35, 0.2, 1)
 GAP = 0.7  # m kept free between things in the room and from the walls: room for a janitor to pass and circle
 FLOOR_CELL = 0.05  # m: the ground-truth floor raster
+LAYOUT_ATTEMPTS = 50
 
 
 @dataclass
@@ -118,15 +119,24 @@ class JanitorialMission(ScenarioMission):
         for name, (lo, hi) in (("size_x", params.size_x), ("size_y", params.size_y)):
             if lo > hi:
                 raise ConfigError(f"{name}=[{lo:g}, {hi:g}]: the lower end must not exceed the upper")
-        size = (float(rng.uniform(*params.size_x)), float(rng.uniform(*params.size_y)))
-        hx, hy = size[0] / 2, size[1] / 2
-        starts = {name: (-hx + 0.5 + 0.65 * k, -hy + 0.5, math.pi / 2) for k, name in enumerate(TEAM)}
-        taken = [(x, y, 0.4) for x, y, _ in starts.values()] + [(-hx + 1.0, -hy + 1.0, 1.2)]  # the start corner
+        for _ in range(LAYOUT_ATTEMPTS):  # a layout that boxes itself in is drawn again, room size and all
+            size = (float(rng.uniform(*params.size_x)), float(rng.uniform(*params.size_y)))
+            hx, hy = size[0] / 2, size[1] / 2
+            starts = {name: (-hx + 0.5 + 0.65 * k, -hy + 0.5, math.pi / 2) for k, name in enumerate(TEAM)}
+            taken = [(x, y, 0.4) for x, y, _ in starts.values()] + [(-hx + 1.0, -hy + 1.0, 1.2)]  # the start corner
+            placed = _Placer(size, rng, taken)
+            try:
+                obstacles = [placed.box(0.15, 0.4) for _ in range(params.obstacles)]
+                furniture = [placed.box(0.2, 0.4) for _ in range(params.objects)]
+                can_spots = [placed.disc(0.15) for _ in range(params.cans)]
+                break
+            except _NoRoom:
+                continue
+        else:
+            raise ConfigError(f"cans={params.cans}, objects={params.objects}, obstacles={params.obstacles}: no layout "
+                              f"in {LAYOUT_ATTEMPTS} draws keeps {GAP:g} m between them in rooms of size_x "
+                              f"{list(params.size_x)}, size_y {list(params.size_y)}; ask for fewer or a larger room")
         frequencies = tuple(f"f{k + 1}" for k in range(params.frequencies))
-        placed = _Placer(size, rng, taken)
-        obstacles = [placed.box(0.15, 0.4) for _ in range(params.obstacles)]
-        furniture = [placed.box(0.2, 0.4) for _ in range(params.objects)]
-        can_spots = [placed.disc(0.15) for _ in range(params.cans)]
         order = rng.permutation(len(can_spots))
         cans = [CanEntry(x, y, frequencies[int(order[k]) % len(frequencies)]) for k, (x, y) in enumerate(can_spots)]
         robots = {name: RobotEntry("janitor", starts[name], controller=JanitorSettings(tools)) for name, tools in
@@ -134,7 +144,8 @@ class JanitorialMission(ScenarioMission):
         for k, (name, kind) in enumerate(newcomers):
             if name in robots:
                 raise ConfigError(f"--fault add-robot:{name}: robot {name!r} is already in the team")
-            robots[name] = RobotEntry(kind, (-hx + 0.5, -hy + 1.3 + 0.65 * k, 0.0), controller=JanitorSettings())
+            robots[name] = RobotEntry(kind, (-hx + 0.5, -hy + 1.3 + 0.65 * k, math.pi / 2),
+                                      controller=JanitorSettings())  # (the west wall on its left, as the team's)
         faults = [FaultEntry("radio-off", name, 0.0) for name in robots] if params.rho == 0 else []
         arena = Arena(size=size, boxes=[BoxObstacle(x, y, h1, h2, 0.3, yaw) for x, y, h1, h2, yaw in obstacles])
         return Scenario(mission=self.name, arena=arena, robots=robots, faults=faults, task=JanitorialTask(
@@ -277,6 +288,10 @@ class JanitorialMission(ScenarioMission):
         return self.complete(world), metrics
 
 
+class _NoRoom(Exception):
+    """No spot left for the next thing."""
+
+
 class _Placer:
     """Things dropped at random in the room, each ``GAP`` clear of the walls and of everything placed before."""
 
@@ -284,13 +299,12 @@ class _Placer:
         self.half, self.rng, self.taken = np.array(size) / 2, rng, list(taken)
 
     def _spot(self, radius: float) -> tuple[float, float]:
-        for _ in range(2000):
+        for _ in range(500):
             x, y = self.rng.uniform(-self.half + radius + GAP, self.half - radius - GAP)
             if all(math.hypot(x - a, y - b) >= radius + r + GAP for a, b, r in self.taken):
                 self.taken.append((x, y, radius))
                 return float(x), float(y)
-        raise ConfigError("the room has no space left for another object with the gaps kept between them; ask for "
-                          "fewer cans, objects or obstacles, or a larger room (size_x, size_y)")
+        raise _NoRoom()
 
     def box(self, lo: float, hi: float) -> tuple[float, float, float, float, float]:
         hx, hy = self.rng.uniform(lo, hi, size=2)

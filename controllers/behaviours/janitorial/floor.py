@@ -12,13 +12,13 @@ the rule give the thesis's "snaking" coverage.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
 from teamsim.controllers.base import Command, Observation
 from teamsim.controllers.skills.follow_surface import FollowParams, FollowRight
-from teamsim.controllers.skills.goto import DriveParams, steer_to, turn_to
+from teamsim.controllers.skills.goto import AvoidObstacles, DriveParams, steer_to, turn_to
 from teamsim.positioning import wrap_angle
 
 QUADRANTS = ("lower-left", "lower-right", "upper-left", "upper-right")
@@ -28,15 +28,19 @@ HEADINGS = ((1, 0), (0, 1), (-1, 0), (0, -1))  # east, north, west, south: index
 
 @dataclass(frozen=True)
 class FloorParams:
-    cell: float = 0.4  # m: the grid's cell, the cleaner's width
+    cell: float = 0.3  # m: the grid's cell, 3/4 of the cleaner's width (neighbouring legs overlap; positions are noisy)
     leave: float = 2.0  # m: the perimeter circuit ends back within ``home`` of its start after driving this far
     home: float = 0.5
+    least_perimeter: float = 8.0  # m: no room is smaller round than this (a janitor needs a room 2 m across),
+    wall_range: float = 0.8  # m from the rim: readings this near, round the circuit, find the walls
+    least_side: float = 2.0  # m: nor are the extents of the robot's centre going round it (a pocket among obstacles)
     arrive: float = 0.2  # m: a cell is reached (and visited) when its centre is this near
-    cell_timeout: float = 10.0  # s to reach the next cell before it counts as inaccessible
+    cell_timeout: float = 8.0  # s (and timeout_per_metre of its distance) to reach a cell before it counts as
+    timeout_per_metre: float = 8.0  # inaccessible
     bump: float = 0.08  # m from the rim: something this near ahead ends the way to the current target
     sense_range: float = 0.3  # m from the rim: lower-ring readings nearer than this mark the cell they end in
     follow: FollowParams = FollowParams(gap=0.1, speed=0.25)
-    drive: DriveParams = DriveParams(cruise=0.3, turn_rate=1.0, slow_radius=0.3)
+    drive: DriveParams = DriveParams(cruise=0.3, turn_rate=1.0, slow_radius=0.05, turn_in_place=0.6)
 
 
 class CoverageGrid:
@@ -97,8 +101,10 @@ class CleanFloor:
     """The behaviour set's competences: perimeter circuit (once), then the coverage of the quadrant it is given.
     ``bounds`` persists between activations; ``completed`` names the quadrants this robot finished."""
 
-    def __init__(self, bearings: np.ndarray, low_ring: np.ndarray, rim: float, params: FloorParams = FloorParams()):
+    def __init__(self, bearings: np.ndarray, low_ring: np.ndarray, rim: float, rng: np.random.Generator,
+                 params: FloorParams = FloorParams()):
         self.params = params
+        self.avoid = AvoidObstacles((), bearings, (), rng, replace(params.drive, avoid_range=params.bump))
         self.rim = rim  # m from the centre to the ring
         self.low = low_ring  # indices of the lower ring in the observation's IR arrays
         self.low_bearings = np.asarray(bearings)[low_ring]
@@ -113,9 +119,12 @@ class CleanFloor:
         self._turned = 0.0  # rad turned since the circuit began (left positive)
         self._last_heading = 0.0
         self._last_position = np.zeros(2)
-        self._away: float | None = None  # heading to leave a circled obstacle on
+        self._away: float | None = None  # heading to leave a circled obstacle on, or to face the first wall
+        self.home: np.ndarray | None = None  # the robot's start pose (set on its first step if not given)
+        self._homed = False
+        self._wall_hits: list[np.ndarray] = []
         self._target: tuple[int, int] | None = None
-        self._target_since = 0.0
+        self._deadline = 0.0  # a target not reached by then is inaccessible
 
     @property
     def finding_dimensions(self) -> bool:
@@ -131,12 +140,23 @@ class CleanFloor:
 
     # -- the perimeter circuit ---------------------------------------------------------------------------------
     def _circuit(self, obs: Observation, pose: np.ndarray) -> Command:
-        """Straight on to the first surface, then follow it round with it on the right. A loop that turned left in
-        all went round the room's walls: it is complete back where it began, or once past a fifth corner (a
-        circuit begun on an obstacle off the wall never comes back to its start). One that turned right (by
-        1.5 pi) went round an obstacle, which the robot leaves, turning left, to find a wall."""
+        """Back to the start (the robots start beside a wall, on their left, as Parker's start in a corner), straight
+        to that wall, then follow it round with it on the right. A loop that turned left in all went round the
+        room: it is complete back where it began, or once past a fifth corner (a circuit begun on an obstacle
+        off the wall never comes back to its start), if it is room-sized. One that turned right (by 1.5 pi) went
+        round an obstacle, which the robot leaves, turning left, to find a wall."""
         p = self.params
         ranges = obs.ir_range[self.low]
+        if self.home is None:
+            self.home = pose.copy()
+        if not self._homed:  # back to the start, beside a wall, and face that wall (on the left at the start)
+            detour = self.avoid(obs)
+            if detour is not None:
+                return self._clean(*detour)
+            move = steer_to(pose, self.home[:2], p.drive, p.home)
+            if move is not None:
+                return self._clean(*move)
+            self._homed, self._away = True, wrap_angle(self.home[2] + math.pi / 2)
         if self._circuit_start is None:
             if self._away is not None:  # turn away from the obstacle just circled, to the left
                 omega = turn_to(pose, self._away, p.drive, tolerance=0.15)
@@ -146,25 +166,45 @@ class CleanFloor:
             if ranges[self.follow.front].min(initial=math.inf) >= p.follow.ahead + 0.05:
                 return self._clean(p.follow.speed, 0.0)
             self._circuit_start, self._extents = pose[:2].copy(), np.array([pose[0], pose[0], pose[1], pose[1]])
+            self._wall_hits = []
             self._path, self._turned, self._last_heading, self._last_position = 0.0, 0.0, pose[2], pose[:2].copy()
         x, y = pose[:2]
         e = self._extents
         self._extents = np.array([min(e[0], x), max(e[1], x), min(e[2], y), max(e[3], y)])
+        self._wall_hits.append(self._hits(ranges, pose, p.wall_range))
         self._turned += wrap_angle(pose[2] - self._last_heading)
         self._last_heading = pose[2]
         self._path += float(np.hypot(*(pose[:2] - self._last_position)))
         self._last_position = pose[:2].copy()
         gone = float(np.hypot(*(pose[:2] - self._circuit_start)))
         closed = self._path > p.leave and gone < p.home
-        if self._turned < -1.5 * math.pi or self._turned > 2.5 * math.pi or closed:
-            if self._turned > math.pi:
-                self.bounds = tuple(float(v) for v in self._extents)
+        round_room = self._turned > 2.5 * math.pi and self._path > p.least_perimeter  # (not spinning on the spot)
+        if self._turned < -1.5 * math.pi or round_room or closed:
+            e = self._extents
+            if self._turned > math.pi and min(e[1] - e[0], e[3] - e[2]) > p.least_side:
+                self.bounds = self._room_bounds()
                 self.grid = CoverageGrid(self.bounds, p.cell)
             else:
                 self._away = wrap_angle(pose[2] + math.pi / 2)
             self._circuit_start = None
             return self._clean(0.0, 0.0)
         return self._clean(*self.follow(ranges))
+
+    def _room_bounds(self) -> tuple[float, float, float, float]:
+        """Where the robot's centre can go: the walls, as the extremes (1st and 99th percentiles, against IR noise)
+        of the lower ring's near readings round the circuit, less the rim and the following gap. The robot's own
+        extremes fall short of a wall wherever it went round a teammate in its way."""
+        hits = np.concatenate(self._wall_hits)
+        (x0, y0), (x1, y1) = np.percentile(hits, 1, axis=0), np.percentile(hits, 99, axis=0)
+        inset = self.rim + self.params.follow.gap
+        return (float(x0 + inset), float(x1 - inset), float(y0 + inset), float(y1 - inset))
+
+    def _hits(self, ranges: np.ndarray, pose: np.ndarray, within: float) -> np.ndarray:
+        """World points where the lower ring's readings nearer than ``within`` end."""
+        near = ranges < within
+        bearings = pose[2] + self.low_bearings[near]
+        reach = self.rim + ranges[near]
+        return pose[:2] + reach[:, None] * np.stack([np.cos(bearings), np.sin(bearings)], axis=1)
 
     # -- quadrant coverage ---------------------------------------------------------------------------------------
     def _cover(self, obs: Observation, pose: np.ndarray) -> Command:
@@ -176,7 +216,7 @@ class CleanFloor:
         region = grid.quadrant(self.quadrant)
         if self._target is not None:
             reached = np.hypot(*(grid.centre(self._target) - pose[:2])) < p.arrive
-            late = obs.time - self._target_since > p.cell_timeout
+            late = obs.time > self._deadline
             if reached:
                 grid.state[self._target] = VISITED
             elif late:
@@ -186,32 +226,30 @@ class CleanFloor:
         if self._target is None:
             heading = round(pose[2] / (math.pi / 2)) % 4  # the grid direction the robot faces
             self._target = next_cell(grid, region, here, heading)
-            self._target_since = obs.time
             if self._target is None:
                 self.completed.append(self.quadrant)
                 return self._clean(0.0, 0.0)
-        if obs.ir_range[self.low][self.follow.front].min() < p.bump:  # something in the way: that cell is out
+            distance = float(np.hypot(*(grid.centre(self._target) - pose[:2])))
+            self._deadline = obs.time + p.cell_timeout + p.timeout_per_metre * distance
+        detour = self.avoid(obs)
+        if detour is not None:  # something in the way: a next-door target is out, a far one is gone round
             if np.hypot(*(grid.centre(self._target) - pose[:2])) < 1.5 * grid.step.max():
                 grid.state[self._target] = BLOCKED
-            self._target = None
-            return self._clean(-0.1, 0.0)
+                self._target = None
+            return self._clean(*detour)
         v, omega = steer_to(pose, grid.centre(self._target), p.drive, 0.0) or (0.0, 0.0)
         return self._clean(max(v, 0.1) if abs(omega) < 0.5 else v, omega)  # no creeping up on a cell centre
 
     def _mark_obstacles(self, obs: Observation, pose: np.ndarray) -> None:
-        """Cells (not yet visited) in which a lower-ring reading within ``sense_range`` ends are inaccessible."""
-        grid, ranges = self.grid, obs.ir_range[self.low]
-        near = ranges < self.params.sense_range
-        if not near.any():
-            return
-        bearings = pose[2] + self.low_bearings[near]
-        reach = self.rim + ranges[near] + grid.step.min() / 4  # a little way into the obstacle
-        points = pose[:2] + reach[:, None] * np.stack([np.cos(bearings), np.sin(bearings)], axis=1)
-        cells = np.round((points - grid.origin) / np.maximum(grid.step, 1e-9)).astype(int)
-        inside = (cells >= 0).all(axis=1) & (cells < np.array(grid.shape)).all(axis=1)
-        for i, j in cells[inside]:
-            if grid.state[i, j] == UNVISITED:
-                grid.state[i, j] = BLOCKED
+        """Cells (not yet visited) where the robot would not fit, from the lower ring: those whose centre lies
+        within the robot's radius of a reading nearer than ``sense_range``."""
+        grid = self.grid
+        for hit in self._hits(obs.ir_range[self.low], pose, self.params.sense_range):
+            lo = np.floor((hit - self.rim - grid.origin) / np.maximum(grid.step, 1e-9)).astype(int)
+            for i in range(max(lo[0], 0), min(lo[0] + 3, grid.shape[0])):
+                for j in range(max(lo[1], 0), min(lo[1] + 3, grid.shape[1])):
+                    if grid.state[i, j] == UNVISITED and np.hypot(*(grid.centre((i, j)) - hit)) < self.rim:
+                        grid.state[i, j] = BLOCKED
 
     def done_with(self, quadrant: str) -> bool:
         return quadrant in self.completed

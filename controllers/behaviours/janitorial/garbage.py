@@ -4,7 +4,7 @@ Each can carries an emitter at one of a few frequencies; an emptied can goes sil
 detectors per frequency, on the front of its rim to the left and right (the mission's sound model,
 ``teamsim.tasks.worlds.janitorial``). The set listens to the frequency its motivational behaviour chose: it turns
 towards the louder detector and drives on; something in the way that is not the can (the level is still low) is
-passed by turning away from it. At the can (loud, and the upper ring sees it close ahead) the emptier goes out and
+gone round, following it on the right for a while (longer each time one is met on the way to the same can). At the can (loud, and the upper ring sees it close ahead) the emptier goes out and
 is held there while the robot creeps up; when that frequency's level drops, the can has gone silent, and the robot
 backs off and follows the gradient on to the next can of the frequency, if any. Constants are assumed.
 """
@@ -16,6 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from teamsim.controllers.base import Command, Observation
+from teamsim.controllers.skills.follow_surface import FollowParams, FollowRight
 from teamsim.positioning import wrap_angle
 
 
@@ -28,7 +29,7 @@ class GarbageParams:
     creep: float = 0.06  # m/s towards the can with the emptier out
     at_can: float = 0.05  # m from the rim: close enough, stop and hold
     avoid: float = 0.3  # m from the rim: something this near ahead that is not the can is avoided
-    avoid_time: float = 1.5  # s of driving on past an obstacle before the gradient steers again
+    detour_time: float = 4.0  # s following an obstacle round before the gradient steers again (longer each time)
     emptied: float = 0.5  # the level falls below this share of its level on arrival: the can is empty
     back_time: float = 2.0  # s backing off an emptied can
     turn_rate: float = 1.0
@@ -49,10 +50,11 @@ class EmptyGarbage:
         self._state = "seek"
         self._until = 0.0
         self._arrival_level = 0.0
-        self._turn = 1.0
+        self._detours = 0  # obstacles met on the way to this can
+        self.follow = FollowRight(np.asarray(bearings)[low_ring], FollowParams(gap=0.15, speed=0.2))
 
     def start(self, frequency: str, time: float) -> None:
-        self.frequency, self._state = frequency, "seek"
+        self.frequency, self._state, self._detours = frequency, "seek", 0
 
     @staticmethod
     def level(obs: Observation, frequency: str) -> tuple[float, float]:
@@ -73,7 +75,7 @@ class EmptyGarbage:
         if self._state == "empty":
             if loud < p.emptied * self._arrival_level:  # gone silent: emptied
                 self.emptied += 1
-                self._state, self._until = "back", obs.time + p.back_time
+                self._state, self._until, self._detours = "back", obs.time + p.back_time, 0
                 return Command(v=-0.15)
             upper_ahead = obs.ir_range[self.upper][self.front].min()
             return Command(v=p.creep if upper_ahead > p.at_can else 0.0,
@@ -81,16 +83,15 @@ class EmptyGarbage:
         if ahead < p.avoid + 0.1 and loud > p.near:  # the can
             self._state, self._arrival_level = "empty", loud
             return Command(v=0.0, extras={"emptier": 1.0})
-        if self._state == "avoid":
-            if obs.time < self._until:
-                return Command(v=p.cruise * 0.6, omega=0.0) if ahead > p.avoid else Command(omega=self._turn)
+        if self._state == "detour":
+            if obs.time < self._until:  # round the obstacle with it on the right, then the gradient again
+                v, omega = self.follow(obs.ir_range[self.low])
+                return Command(v=v, omega=omega, extras={"emptier": 0.0})
             self._state = "seek"
-        if ahead < p.avoid:  # an obstacle: turn away from the side that sees more, then drive past it
-            near = obs.ir_range[self.upper] < 2 * p.avoid
-            self._turn = -p.turn_rate if np.count_nonzero(near & self.left) > np.count_nonzero(near & ~self.left) \
-                else p.turn_rate
-            self._state, self._until = "avoid", obs.time + p.avoid_time
-            return Command(omega=self._turn)
+        if ahead < p.avoid:  # an obstacle (not the can): go round it for a while
+            self._detours += 1
+            self._state, self._until = "detour", obs.time + p.detour_time * min(self._detours, 4)
+            return Command(omega=p.turn_rate, extras={"emptier": 0.0})
         omega = self._steer(left, right)
         return Command(v=p.cruise * max(0.0, 1.0 - abs(omega) / p.turn_rate), omega=omega, extras={"emptier": 0.0})
 

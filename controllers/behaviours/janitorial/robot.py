@@ -29,6 +29,7 @@ from teamsim.controllers.base import Command, Observation
 from teamsim.controllers.behaviours.janitorial.dusting import DustClaims, DustFurniture, DustParams
 from teamsim.controllers.behaviours.janitorial.floor import QUADRANTS, CleanFloor, FloorParams
 from teamsim.controllers.behaviours.janitorial.garbage import EmptyGarbage, GarbageParams
+from teamsim.controllers.skills.goto import Unstick
 from teamsim.controllers.skills.pose_estimate import PoseEstimate
 from teamsim.models.janitor import CLEAN, DUST, EMPTY, TOOL_OF_TASK
 from teamsim.models.robot import RobotModel
@@ -77,6 +78,7 @@ class JanitorRobot:
         low = np.array([k for k, n in enumerate(names) if n.startswith("low")])
         bearings = robot.ir_bearings
         self.estimate = PoseEstimate(robot.drive)
+        self.unstick = Unstick(rng)  # wedged (between a can and an idle teammate, say): back off and turn
         self.behaviours: dict[str, tuple[object, str]] = {}  # set -> (behaviour, sub-task)
         sets = []
         if EMPTY in tasks:
@@ -90,11 +92,12 @@ class JanitorRobot:
             sets.append(BehaviourSet(DUST, rates=params.dust_rates.motivation()))
             self.behaviours[DUST] = (self.dust, "")
         if CLEAN in tasks:
-            self.floor = CleanFloor(bearings, low, robot.footprint_radius, params.floor)
+            self.floor = CleanFloor(bearings, low, robot.footprint_radius, rng, params.floor)
             for q in QUADRANTS:
                 sets.append(BehaviourSet(f"{CLEAN} {q}", rates=params.floor_rates.motivation()))
                 self.behaviours[sets[-1].name] = (self.floor, q)
         self.tasks = tasks
+        self.phi = {s.name: s.rates.phi for s in sets}
         self.name = robot.name
         self.alliance = AllianceRobot(robot.name, sets, AllianceParams(threshold=params.threshold, tau=tau),
                                       precedes=self._precedes)
@@ -127,11 +130,17 @@ class JanitorRobot:
         return feedback
 
     def _precedes(self, task: str, teammate: str) -> bool:
-        """First come, first served: psi yields a sub-task only to a teammate that began it earlier (by the start
-        time its messages carry), or at the same time and before this robot in name order."""
-        their_task, their_start = self.began.get(teammate, (None, 0.0))
+        """Whether psi yields ``task`` to ``teammate``: first come, first served, unless the later one came after
+        its impatience with the first ran out (after phi), when the first yields to it (§3.6). Start times are
+        the ones teammates' messages carry; a tie goes to the name first in order."""
+        their_task, theirs = self.began.get(teammate, (None, 0.0))
+        if their_task != task:
+            return False
         mine = self.alliance.active_since
-        return their_task == task and (their_start < mine or (their_start == mine and teammate < self.name))
+        phi = self.phi[task]
+        if theirs < mine or (theirs == mine and teammate < self.name):
+            return mine - theirs < phi  # they were first, and I did not take it over out of impatience
+        return theirs - mine >= phi  # they took it over from me out of impatience
 
     # -- the control step ----------------------------------------------------------------------------------------
     def __call__(self, obs: Observation) -> Command:
@@ -149,7 +158,7 @@ class JanitorRobot:
         behaviour, _ = self.behaviours[active]
         if behaviour is getattr(self, "dust", None):
             self.dust.ignore = self.claims.ignore_list(obs.time)
-        command = behaviour(obs, pose)
+        command = self.unstick(obs, behaviour(obs, pose))
         self._record_completions()
         return Command(v=command.v, omega=command.omega, behaviour=active, extras={**self.tools, **command.extras},
                        trace=trace, broadcast=self._message(active))

@@ -1,0 +1,114 @@
+"""The janitorial behaviour sets' algorithms (Parker §6.2.1): the coverage rule, the dust claims, first come first
+served for psi, and the janitor model's tools."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from teamsim.controllers.alliance.motivation import AllianceParams, AllianceRobot, BehaviourSet, MotivationRates
+from teamsim.controllers.behaviours.janitorial.dusting import DustClaims
+from teamsim.controllers.behaviours.janitorial.floor import BLOCKED, VISITED, CoverageGrid, next_cell
+from teamsim.models import build_robot
+from teamsim.radio import Message
+
+
+def grid_3x3() -> CoverageGrid:
+    return CoverageGrid((0.0, 0.8, 0.0, 0.8), 0.4)  # cells (0..2, 0..2), centres 0.4 m apart
+
+
+def test_grid_cells_and_quadrants_tile_the_rectangle():
+    grid = CoverageGrid((-1.0, 1.0, -0.6, 0.6), 0.4)
+    assert grid.shape == (6, 4)
+    assert np.allclose(grid.centre((0, 0)), (-1.0, -0.6)) and np.allclose(grid.centre((5, 3)), (1.0, 0.6))
+    assert grid.cell_of(0.95, 0.55) == (5, 3)
+    masks = [grid.quadrant(q) for q in ("lower-left", "lower-right", "upper-left", "upper-right")]
+    assert np.array_equal(sum(m.astype(int) for m in masks), np.ones(grid.shape, int))  # each cell in one quadrant
+    assert masks[0][0, 0] and masks[3][5, 3] and masks[1][5, 0] and masks[2][0, 3]
+
+
+@pytest.mark.parametrize("visited, expected", [
+    ((), (1, 0)),  # facing north from the middle: the cell on the right (east) first
+    (((1, 0),), (0, 1)),  # right visited: straight on
+    (((1, 0), (0, 1)), (-1, 0)),  # right and front visited: left
+])
+def test_coverage_rule_right_then_straight_then_left(visited, expected):
+    grid, here = grid_3x3(), (1, 1)
+    grid.state[here] = VISITED
+    for dx, dy in visited:
+        grid.state[here[0] + dx, here[1] + dy] = VISITED
+    region = np.ones(grid.shape, bool)
+    assert next_cell(grid, region, here, heading=1) == (here[0] + expected[0], here[1] + expected[1])
+
+
+def test_coverage_rule_heads_for_the_nearest_unvisited_cell_then_declares_completion():
+    grid, region = grid_3x3(), np.ones((3, 3), bool)
+    grid.state[:] = VISITED
+    grid.state[2, 2] = 0  # the only unvisited cell, not a neighbour of (0, 0)
+    grid.state[0, 2] = BLOCKED
+    assert next_cell(grid, region, (0, 0), heading=0) == (2, 2)
+    grid.state[2, 2] = BLOCKED  # inaccessible cells are never targets
+    assert next_cell(grid, region, (0, 0), heading=0) is None
+
+
+def test_coverage_rule_stays_in_its_region():
+    grid = grid_3x3()
+    region = np.zeros((3, 3), bool)
+    region[0, :] = True
+    grid.state[0, 0] = VISITED
+    assert next_cell(grid, region, (0, 0), heading=0) == (0, 1)  # east is outside the region: left (north)
+
+
+def test_dust_claims_honour_a_teammate_for_theta_over_delta_slow_then_make_it_fair_game():
+    claims = DustClaims(delta_slow=0.1, threshold=1.0, same_object=0.8)  # 10 s of patience
+    claims.hear("r3", [1.0, 2.0], time=5.0)
+    claims.hear("r3", [1.1, 2.05], time=8.0)  # the same object: patience still counts from 5 s
+    assert [tuple(p) for p in claims.ignore_list(14.9)] == [(1.0, 2.0)]
+    assert claims.ignore_list(15.0) == []
+    claims.completed([1.05, 2.0])
+    claims.completed([1.3, 2.2])  # the same object again
+    assert len(claims.done) == 1 and len(claims.ignore_list(100.0)) == 1
+    claims.hear("r3", None, 20.0)  # searching again: no claim
+    assert claims.claims == {}
+
+
+def _garbage_robot(name: str, precedes=None) -> AllianceRobot:
+    rates = MotivationRates(delta_fast=0.5, delta_slow=0.05, phi=100.0, psi=5.0, lam=1000.0)
+    return AllianceRobot(name, [BehaviourSet("empty-garbage f1", rates=rates)], AllianceParams(tau=100.0),
+                         precedes=precedes)
+
+
+@pytest.mark.parametrize("teammate_began, yields", [(1.0, True), (3.0, False)])
+def test_psi_yields_only_to_a_teammate_that_began_first(teammate_began, yields):
+    """Two robots that start on the same sub-task: with ``precedes``, only the later one yields after psi (without
+    it both yield at once, as in the literal rule, and meet again)."""
+    def precedes(task, teammate):
+        return teammate_began < robot.active_since
+
+    robot = _garbage_robot("r1", precedes)
+    claim = [Message("r2", 0.0, {"task": "empty-garbage f1"})]
+    t, active = 0.0, None
+    while t < 12.0:
+        active, trace = robot.step(t, {"empty-garbage f1": True}, claim if t >= 2.5 else [], None)
+        if t > 2.0 and active is None:
+            break
+        t = round(t + 0.1, 6)
+    assert robot.active_since == pytest.approx(2.1)
+    assert (active is None) == yields
+
+
+def test_literal_psi_yields_to_any_claimant():
+    robot = _garbage_robot("r1")
+    claim = [Message("r2", 0.0, {"task": "empty-garbage f1"})]
+    t = 0.0
+    for _ in range(120):
+        active, _ = robot.step(t, {"empty-garbage f1": True}, claim if t >= 2.5 else [], None)
+        t = round(t + 0.1, 6)
+    assert active is None
+
+
+def test_janitor_carries_the_tools_of_its_tasks_only():
+    r1 = build_robot("janitor", "r1", tools=("empty-garbage", "dust-furniture"))
+    assert set(r1.effectors) == {"emptier", "duster"}
+    assert sum(n.startswith("low") for n in r1.ir_sensors) == sum(n.startswith("ir") for n in r1.ir_sensors) == 12
+    with pytest.raises(ValueError, match="unknown task 'mop'"):
+        build_robot("janitor", "r9", tools=("mop",))
