@@ -46,7 +46,3 @@ class FollowRight:
         if ranges[self.right_front].min(initial=math.inf) < p.gap:  # converging on it ahead-right: ease off
             omega += 0.5 * p.turn_rate
         return p.speed, float(np.clip(omega, -p.turn_rate, p.turn_rate))
-
-    def sees_surface(self, ranges: np.ndarray) -> bool:
-        """Something within reach on the right or ahead."""
-        return bool(ranges[self.right | self.front].min(initial=math.inf) < 3 * self.params.gap + 0.2)

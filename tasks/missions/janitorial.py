@@ -18,7 +18,9 @@ from __future__ import annotations
 import dataclasses
 import math
 from dataclasses import dataclass, field
+from pathlib import Path
 
+import cv2
 import numpy as np
 
 from teamsim.config import ConfigError, RadioConfig, setting
@@ -29,6 +31,7 @@ from teamsim.positioning import wrap_angle
 from teamsim.scenario import MAX_EXTENT, Arena, BoxObstacle, FaultEntry, RobotEntry, Scenario, scene_of
 from teamsim.scene import Scene
 from teamsim.tasks.base import ScenarioMission
+from teamsim.tasks.missions.janitorial_figures import floor_image, write_floor
 from teamsim.tasks.worlds.janitorial import Can, Cans, Floor, Furniture, detector_levels, rasterise
 
 TEAM = {"r1": ("empty-garbage", "dust-furniture"), "r2": ("empty-garbage", "clean-floor"),
@@ -39,6 +42,7 @@ EMPTIED_RGBA, DUSTED_RGBA, FURNITURE_RGBA = (0.55, 0.55, 0.55, 1), (0.95, 0.9, 0
 GAP = 0.7  # m kept free between things in the room and from the walls: room for a janitor to pass and circle
 FLOOR_CELL = 0.05  # m: the ground-truth floor raster
 LAYOUT_ATTEMPTS = 50
+PANEL_PERIOD = 2.0  # s between redraws of the video's floor panel
 
 
 @dataclass
@@ -257,6 +261,24 @@ class JanitorialMission(ScenarioMission):
         for k, done in enumerate(info["furniture"].done_at):
             if done is not None:
                 world.model.geom(f"furniture{k}").rgba[:] = DUSTED_RGBA
+
+    # -- pictures ------------------------------------------------------------------------------------------------------
+    def _picture(self, world) -> np.ndarray:
+        task = world.scene.scenario.task
+        robots = {n: world.pose(r)[:2] for n, r in world.robots.items() if r.active}
+        return floor_image(world.scene.info, dict(zip(task.frequencies, FREQUENCY_RGBA)), robots, world.time)
+
+    def video_panel(self, world) -> np.ndarray | None:
+        """The floor as cleaned so far, the dusted furniture and the emptied cans, beside the 3-D view."""
+        info = world.scene.info
+        if world.time < info.get("panel_time", -math.inf) + PANEL_PERIOD:
+            return None
+        info["panel_time"] = world.time
+        return cv2.cvtColor(self._picture(world), cv2.COLOR_BGR2RGB)
+
+    def write_outputs(self, world, run_dir: Path) -> None:
+        """``floor.png``: the floor, furniture and cans as the mission ended."""
+        write_floor(run_dir / "floor.png", self._picture(world))
 
     def complete(self, world) -> bool:
         info, task = world.scene.info, world.scene.scenario.task

@@ -2,12 +2,13 @@
 
 An object is dustable when it triggers the lower IR ring and not the upper one (it is lower than the upper ring;
 walls, cans, tall furniture and robots trigger both). The robot searches by a random walk (Parker's "simple
-wandering technique": straight legs, a new random heading away from whatever ends one, the least familiar of a
-few drawn, from its memory of where it has been: an unbiased walk kept two robots in half of a cluttered room
-for 700 s) until it sees one away from every location on its ignore list (objects dusted, or being dusted by a teammate whose
-claim it still honours: :class:`DustClaims`), drives to it, swings the duster out and circles the object with it
-on its right (:mod:`teamsim.controllers.skills.follow_surface`). The object's location is the centroid of the
-surface points the lower ring saw on the right while circling; a turn and an eighth round it completes the object. Constants are assumed.
+wandering technique": straight legs, a new random heading away from whatever ends one, the least familiar of a few
+drawn, from its memory of where it has been: an unbiased walk kept two robots in half of a cluttered room for 700 s)
+until it sees one away from every location on its ignore list (objects dusted, or being dusted by a teammate whose
+claim it still honours: :class:`DustClaims`), drives to it, swings the duster out and circles the object with it on
+its right (:mod:`teamsim.controllers.skills.follow_surface`). The object's location is the centroid of the surface
+points the lower ring saw on the right while circling; a turn and an eighth round it completes the object. Constants
+are assumed.
 """
 from __future__ import annotations
 

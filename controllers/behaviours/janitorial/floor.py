@@ -251,9 +251,6 @@ class CleanFloor:
                     if grid.state[i, j] == UNVISITED and np.hypot(*(grid.centre((i, j)) - hit)) < self.rim:
                         grid.state[i, j] = BLOCKED
 
-    def done_with(self, quadrant: str) -> bool:
-        return quadrant in self.completed
-
     @staticmethod
     def _clean(v: float, omega: float) -> Command:
         return Command(v=v, omega=omega, extras={"cleaner": 1.0})

@@ -3,10 +3,11 @@
 Each can carries an emitter at one of a few frequencies; an emptied can goes silent. A garbage robot has two
 detectors per frequency, on the front of its rim to the left and right (the mission's sound model,
 ``teamsim.tasks.worlds.janitorial``). The set listens to the frequency its motivational behaviour chose: it turns
-towards the louder detector and drives on; something in the way that is not the can (the level is still low) is
-gone round, following it on the right for a while (longer each time one is met on the way to the same can). At the can (loud, and the upper ring sees it close ahead) the emptier goes out and
-is held there while the robot creeps up; when that frequency's level drops, the can has gone silent, and the robot
-backs off and follows the gradient on to the next can of the frequency, if any. Constants are assumed.
+towards the louder detector and drives on; something in the way that is not the can (the level is still low) is gone
+round, following it on the right for a while (longer each time one is met on the way to the same can). At the can
+(loud, and the upper ring sees it close ahead) the emptier goes out and is held there while the robot creeps up;
+when that frequency's level drops, the can has gone silent, and the robot backs off and follows the gradient on to
+the next can of the frequency, if any. Constants are assumed.
 """
 from __future__ import annotations
 
@@ -44,7 +45,6 @@ class EmptyGarbage:
         self.upper, self.low = upper_ring, low_ring
         b = np.array([wrap_angle(float(x)) for x in np.asarray(bearings)[upper_ring]])
         self.front = np.abs(b) < math.radians(35)
-        self.left = b > 0
         self.frequency: str | None = None
         self.emptied = 0
         self._state = "seek"
