@@ -7,7 +7,8 @@ drawn, from its memory of where it has been: an unbiased walk kept two robots in
 until it sees one away from every location on its ignore list (objects dusted, or being dusted by a teammate whose
 claim it still honours: :class:`DustClaims`), drives to it, swings the duster out and circles the object with it on
 its right (:mod:`teamsim.controllers.skills.follow_surface`). The object's location is the centroid of the surface
-points the lower ring saw on the right while circling; a turn and an eighth round it completes the object. Constants
+points the lower ring saw on the right while circling; a full turn round it, with the surface seen from all round,
+completes the object. Constants
 are assumed.
 """
 from __future__ import annotations
@@ -31,7 +32,8 @@ class DustParams:
     same_object: float = 0.8  # m: a sighting this near an ignored location is that object
     approach_gap: float = 0.15  # m from the rim: close enough to start circling
     approach_timeout: float = 20.0  # s
-    circle_turn: float = 2.25 * math.pi  # rad round the object: a full turn and an eighth, overlapping the start
+    circle_turn: float = 2 * math.pi  # rad round the object, and its surface seen in seen_sectors of 12 directions
+    seen_sectors: int = 11  # (a teammate in the way pushes the robot off a side, which it then has not dusted)
     circle_timeout: float = 150.0  # s: an object not circled by then is taken as done (its sides are blocked)
     follow: FollowParams = FollowParams(gap=0.08, speed=0.15, ahead=0.15)
     drive: DriveParams = DriveParams(cruise=0.25, turn_rate=1.0)
@@ -90,7 +92,8 @@ class DustFurniture:
         self._state = "search"
         self._since = 0.0
         self._hits: list[np.ndarray] = []
-        self._swept = 0.0
+        self._swept = 0.0  # rad round the object, clockwise (it is on the right)
+        self._sighted = np.zeros(2)  # where the object being dusted was first seen
         self._last_angle: float | None = None
 
     @property
@@ -106,7 +109,7 @@ class DustFurniture:
             sighting = self._confirmed(self._sighting(obs, pose))
             if sighting is None:
                 return self._walk(obs, pose)
-            self._state, self._since, self.target = "approach", obs.time, sighting
+            self._state, self._since, self.target, self._sighted = "approach", obs.time, sighting, sighting
         if self._state == "approach":
             ahead = np.abs(self.bearings) < math.radians(40)
             near = obs.ir_range[self.low][ahead].min()
@@ -127,20 +130,28 @@ class DustFurniture:
     def _circle(self, obs: Observation, pose: np.ndarray) -> Command:
         p = self.params
         ranges = obs.ir_range[self.low]
-        self._hits += self._object_points(obs, pose, np.where(self.follow.right, ranges, np.inf),
-                                          p.follow.gap * 3 + 0.2)  # the right side only: the object circled
+        seen = self._object_points(obs, pose, np.where(self.follow.right, ranges, np.inf), p.follow.gap * 3 + 0.2)
+        # The right side only (the object circled), and near where it was first seen (not a neighbour's side).
+        self._hits += [q for q in seen if np.hypot(*(q - self._sighted)) < p.same_object]
         if self._hits:
             self.target = np.mean(self._hits, axis=0)
             angle = math.atan2(pose[1] - self.target[1], pose[0] - self.target[0])
             if self._last_angle is not None:
-                self._swept += abs(wrap_angle(angle - self._last_angle))
+                self._swept -= wrap_angle(angle - self._last_angle)  # clockwise round it is progress
             self._last_angle = angle
-        if self._swept >= p.circle_turn or obs.time - self._since > p.circle_timeout:
+        if (self._swept >= p.circle_turn and self._seen_round() >= p.seen_sectors) or \
+                obs.time - self._since > p.circle_timeout:
             self.finished.append(self.target.copy())
             self._state, self.target = "search", None
             return Command(extras={"duster": 0.0})
         v, omega = self.follow(ranges)
         return Command(v=v, omega=omega, extras={"duster": 1.0})
+
+    def _seen_round(self) -> int:
+        """In how many of 12 directions from the object's centroid the lower ring has seen its surface."""
+        offsets = np.array(self._hits) - self.target
+        sectors = np.floor((np.arctan2(offsets[:, 1], offsets[:, 0]) + math.pi) / (math.pi / 6)).astype(int) % 12
+        return len(set(sectors.tolist()))
 
     def _object_points(self, obs: Observation, pose: np.ndarray, low: np.ndarray, reach: float) -> list[np.ndarray]:
         """World points of the lower ring's readings within ``reach`` that the upper ring does not share."""

@@ -12,6 +12,7 @@ the rule give the thesis's "snaking" coverage.
 from __future__ import annotations
 
 import math
+import heapq
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -23,6 +24,7 @@ from teamsim.positioning import wrap_angle
 
 QUADRANTS = ("lower-left", "lower-right", "upper-left", "upper-right")
 UNVISITED, VISITED, BLOCKED = 0, 1, 2
+BLOCKED_COST = 25.0  # steps a planned path pays to cross a cell marked inaccessible
 HEADINGS = ((1, 0), (0, 1), (-1, 0), (0, -1))  # east, north, west, south: index + 1 turns left
 
 
@@ -97,6 +99,34 @@ def nearest_unvisited(grid: CoverageGrid, region: np.ndarray, start: tuple[int, 
     return int(cells[k][0]), int(cells[k][1])
 
 
+def shortest_path(grid: CoverageGrid, start: tuple[int, int], goal: tuple[int, int]) -> list:
+    """Cells from next to ``start`` to ``goal`` (4-connected, Dijkstra): a step into a cell known to be inaccessible
+    costs ``BLOCKED_COST`` steps, so a way round is taken where there is one, and a robot hemmed in by marks (a
+    teammate standing by it, a reading from a wall) can still get out. ``[goal]`` when it is in ``goal``'s cell."""
+    cost = {start: 0.0}
+    previous = {start: None}
+    heap = [(0.0, start)]
+    while heap:
+        d, c = heapq.heappop(heap)
+        if c == goal:
+            break
+        if d > cost[c]:
+            continue
+        for dx, dy in HEADINGS:
+            n = (c[0] + dx, c[1] + dy)
+            if not grid.inside(n):
+                continue
+            step = BLOCKED_COST if grid.state[n] == BLOCKED and n != goal else 1.0
+            if d + step < cost.get(n, math.inf):
+                cost[n], previous[n] = d + step, c
+                heapq.heappush(heap, (d + step, n))
+    path, c = [], goal
+    while c != start:
+        path.append(c)
+        c = previous[c]
+    return path[::-1] or [goal]
+
+
 class CleanFloor:
     """The behaviour set's competences: perimeter circuit (once), then the coverage of the quadrant it is given.
     ``bounds`` persists between activations; ``completed`` names the quadrants this robot finished."""
@@ -104,7 +134,10 @@ class CleanFloor:
     def __init__(self, bearings: np.ndarray, low_ring: np.ndarray, rim: float, rng: np.random.Generator,
                  params: FloorParams = FloorParams()):
         self.params = params
-        self.avoid = AvoidObstacles((), bearings, (), rng, replace(params.drive, avoid_range=params.bump))
+        front = np.abs(np.angle(np.exp(1j * np.asarray(bearings)))) < math.radians(50)
+        # Avoid-obstacles on what is ahead only: cells along a wall put the side sensors that near it.
+        self._avoid = AvoidObstacles((), bearings, (), rng, replace(params.drive, avoid_range=params.bump))
+        self.ahead = front
         self.rim = rim  # m from the centre to the ring
         self.low = low_ring  # indices of the lower ring in the observation's IR arrays
         self.low_bearings = np.asarray(bearings)[low_ring]
@@ -125,6 +158,7 @@ class CleanFloor:
         self._wall_hits: list[np.ndarray] = []
         self._target: tuple[int, int] | None = None
         self._deadline = 0.0  # a target not reached by then is inaccessible
+        self._route: list = []  # cells to the target
 
     @property
     def finding_dimensions(self) -> bool:
@@ -143,7 +177,8 @@ class CleanFloor:
         """Back to the start (the robots start beside a wall, on their left, as Parker's start in a corner), straight
         to that wall, then follow it round with it on the right. A loop that turned left in all went round the
         room: it is complete back where it began, or once past a fifth corner (a circuit begun on an obstacle
-        off the wall never comes back to its start), if it is room-sized. One that turned right (by 1.5 pi) went
+        off the wall never comes back to its start), if it is room-sized and holds the start (a pocket among
+        obstacles does not). One that turned right (by 1.5 pi) went
         round an obstacle, which the robot leaves, turning left, to find a wall."""
         p = self.params
         ranges = obs.ir_range[self.low]
@@ -181,8 +216,11 @@ class CleanFloor:
         round_room = self._turned > 2.5 * math.pi and self._path > p.least_perimeter  # (not spinning on the spot)
         if self._turned < -1.5 * math.pi or round_room or closed:
             e = self._extents
-            if self._turned > math.pi and min(e[1] - e[0], e[3] - e[2]) > p.least_side:
-                self.bounds = self._room_bounds()
+            bounds = self._room_bounds()
+            inside = bounds[0] - p.home <= self.home[0] <= bounds[1] + p.home and \
+                bounds[2] - p.home <= self.home[1] <= bounds[3] + p.home  # the room holds the start
+            if self._turned > math.pi and min(e[1] - e[0], e[3] - e[2]) > p.least_side and inside:
+                self.bounds = bounds
                 self.grid = CoverageGrid(self.bounds, p.cell)
             else:
                 self._away = wrap_angle(pose[2] + math.pi / 2)
@@ -208,37 +246,43 @@ class CleanFloor:
 
     # -- quadrant coverage ---------------------------------------------------------------------------------------
     def _cover(self, obs: Observation, pose: np.ndarray) -> Command:
+        """The next cell by the coverage rule, reached along a shortest path round the cells known inaccessible
+        (replanned when one on it turns out to be); a cell not reached in time, or bumped into next door, is
+        inaccessible."""
         p, grid = self.params, self.grid
         self._mark_obstacles(obs, pose)
         here = grid.cell_of(*pose[:2])
         if np.hypot(*(grid.centre(here) - pose[:2])) < p.arrive:
             grid.state[here] = VISITED
-        region = grid.quadrant(self.quadrant)
-        if self._target is not None:
-            reached = np.hypot(*(grid.centre(self._target) - pose[:2])) < p.arrive
-            late = obs.time > self._deadline
-            if reached:
-                grid.state[self._target] = VISITED
-            elif late:
-                grid.state[self._target] = BLOCKED
-            if reached or grid.state[self._target] == BLOCKED:
-                self._target = None
+        if self._target is not None and (grid.state[self._target] != UNVISITED or obs.time > self._deadline):
+            if grid.state[self._target] == UNVISITED:
+                grid.state[self._target] = BLOCKED  # not reached in time
+            self._target = None
         if self._target is None:
             heading = round(pose[2] / (math.pi / 2)) % 4  # the grid direction the robot faces
-            self._target = next_cell(grid, region, here, heading)
+            self._target = next_cell(grid, grid.quadrant(self.quadrant), here, heading)
             if self._target is None:
                 self.completed.append(self.quadrant)
                 return self._clean(0.0, 0.0)
-            distance = float(np.hypot(*(grid.centre(self._target) - pose[:2])))
-            self._deadline = obs.time + p.cell_timeout + p.timeout_per_metre * distance
+            self._route = shortest_path(grid, here, self._target)
+            self._deadline = obs.time + p.cell_timeout + p.timeout_per_metre * grid.step.mean() * len(self._route)
+        if any(grid.state[c] == BLOCKED for c in self._route[1:]):  # (the next step may be the way out)
+            self._route = shortest_path(grid, here, self._target)
+        while len(self._route) > 1 and np.hypot(*(grid.centre(self._route[0]) - pose[:2])) < p.arrive:
+            self._route.pop(0)
+        waypoint = self._route[0]
         detour = self.avoid(obs)
-        if detour is not None:  # something in the way: a next-door target is out, a far one is gone round
-            if np.hypot(*(grid.centre(self._target) - pose[:2])) < 1.5 * grid.step.max():
-                grid.state[self._target] = BLOCKED
-                self._target = None
+        if detour is not None:  # something in the way: the cell next door is out, a far one is gone round
+            if np.hypot(*(grid.centre(waypoint) - pose[:2])) < 1.5 * grid.step.max():
+                grid.state[waypoint] = BLOCKED
             return self._clean(*detour)
-        v, omega = steer_to(pose, grid.centre(self._target), p.drive, 0.0) or (0.0, 0.0)
+        v, omega = steer_to(pose, grid.centre(waypoint), p.drive, 0.0) or (0.0, 0.0)
         return self._clean(max(v, 0.1) if abs(omega) < 0.5 else v, omega)  # no creeping up on a cell centre
+
+    def avoid(self, obs: Observation) -> tuple[float, float] | None:
+        """Avoid-obstacles (:class:`AvoidObstacles`) on what is ahead only: along a wall the side sensors are that
+        near it all the time."""
+        return self._avoid(replace(obs, ir_range=np.where(self.ahead, obs.ir_range, np.inf)))
 
     def _mark_obstacles(self, obs: Observation, pose: np.ndarray) -> None:
         """Cells (not yet visited) where the robot would not fit, from the lower ring: those whose centre lies
