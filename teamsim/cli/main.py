@@ -16,6 +16,7 @@ from teamsim.gl import RenderBackendError
 # teamsim.tasks.studies.cleanup_faults.CONDITIONS, spelled out so that building the parser imports no physics
 CLEANUP_CONDITIONS = ("none", "kill-red", "radio-off", "break-gripper")
 BOX_EXPERIMENTS = ("robot-failure", "heterogeneity")  # teamsim.tasks.studies.box_pushing.EXPERIMENTS
+JANITORIAL_RHOS = (0.0, 0.1, 0.5, 2.0)  # teamsim.tasks.studies.janitorial_rho.JanitorialRhoStudy.rhos
 
 EXIT_USAGE = 2
 
@@ -102,6 +103,15 @@ def _build_parser() -> argparse.ArgumentParser:
     awareness.add_argument("--missions", type=_positive_int("--missions"), default=10, help="missions per version")
     awareness.add_argument("--duration", type=float, help="simulated seconds per mission (mission default if unset)")
     _run_options(awareness, workers=2, out="renders/study-awareness")
+
+    rho = studies.add_parser("janitorial-rho", help="Parker §6.2.3: the janitorial service's mission time at "
+                                                    "broadcast rates rho (Fig. 6-13)")
+    rho.add_argument("--missions", type=_positive_int("--missions"), default=10, help="missions per rate")
+    rho.add_argument("--rhos", type=_csv_of("rho", None, float), default=JANITORIAL_RHOS,
+                     help="comma-separated broadcasts per second per robot, 0 = no messages (default: "
+                          f"{','.join(f'{r:g}' for r in JANITORIAL_RHOS)})")
+    rho.add_argument("--duration", type=float, help="simulated seconds per mission (mission default if unset)")
+    _run_options(rho, workers=2, out="renders/study-janitorial-rho")
 
     faults = studies.add_parser("cleanup-faults", help="Parker §3.8.4: the 3-robot cleanup with red killed during "
                                                        "the search, the radio off, a gripper broken")
@@ -198,6 +208,16 @@ def cmd_study(args) -> int:
         out = run_study(AwarenessStudy(missions=args.missions, seed=args.seed, workers=args.workers, out=args.out,
                                        duration=args.duration))
         print(f"wrote {out / 'report.md'} and {out / 'results.csv'}")
+    elif args.study == "janitorial-rho":
+        if not all(0.0 <= rho <= 100.0 for rho in args.rhos):  # (NaN fails too)
+            raise ConfigError("--rhos: each must be a number of broadcasts per second in [0, 100]")
+        if args.duration is not None and not args.duration > 0:
+            raise ConfigError("--duration: must be > 0 simulated seconds")
+        from teamsim.tasks.studies.janitorial_rho import JanitorialRhoStudy, run_study
+
+        out = run_study(JanitorialRhoStudy(rhos=args.rhos, missions=args.missions, seed=args.seed,
+                                           workers=args.workers, out=args.out, duration=args.duration))
+        print(f"wrote {out / 'report.md'}, {out / 'times.png'} and {out / 'results.csv'}")
     elif args.study == "cleanup-faults":
         from teamsim.tasks.studies.cleanup_faults import CleanupFaultStudy, run_study
 
@@ -288,6 +308,7 @@ def cmd_list(_args) -> int:
     print("  two-tier-astar   Chand ch.4: memory-constrained two-tiered A* vs monolithic, no physics")
     print("  lalliance        Parker §4.5: L-ALLIANCE strategies I-IV, abstract (no physics)")
     print("  awareness        Parker ch.5: the cleanup with and without awareness, versions I-IV")
+    print("  janitorial-rho   Parker §6.2.3: the janitorial service's mission time at broadcast rates rho")
     print("  cleanup-faults   Parker §3.8.4: the cleanup with red killed, the radio off, a gripper broken")
     print("  box-pushing      Parker §6.1.2: an R-2 taken away and returned; an R-2 replaced by Genghis-II")
     return 0

@@ -146,6 +146,8 @@ class CleanFloor:
         self.grid: CoverageGrid | None = None
         self.quadrant: str | None = None
         self.completed: list[str] = []
+        self.verified: list[str] = []  # quadrants it covered again to verify them
+        self._verifying = False
         self._circuit_start: np.ndarray | None = None
         self._extents: np.ndarray | None = None
         self._path = 0.0  # m driven since the circuit began
@@ -164,8 +166,11 @@ class CleanFloor:
     def finding_dimensions(self) -> bool:
         return self.bounds is None
 
-    def start(self, quadrant: str, time: float) -> None:
-        self.quadrant, self._target = quadrant, None
+    def start(self, quadrant: str, time: float, verify: bool = False) -> None:
+        """Clean ``quadrant``; ``verify``: again, every cell of it unvisited (and unmarked) once more."""
+        self.quadrant, self._target, self._verifying = quadrant, None, verify
+        if verify and self.grid is not None:
+            self.grid.state[self.grid.quadrant(quadrant)] = UNVISITED
 
     def __call__(self, obs: Observation, pose: np.ndarray) -> Command:
         if self.bounds is None:
@@ -262,7 +267,7 @@ class CleanFloor:
             heading = round(pose[2] / (math.pi / 2)) % 4  # the grid direction the robot faces
             self._target = next_cell(grid, grid.quadrant(self.quadrant), here, heading)
             if self._target is None:
-                self.completed.append(self.quadrant)
+                (self.verified if self._verifying else self.completed).append(self.quadrant)
                 return self._clean(0.0, 0.0)
             self._route = shortest_path(grid, here, self._target)
             self._deadline = obs.time + p.cell_timeout + p.timeout_per_metre * grid.step.mean() * len(self._route)

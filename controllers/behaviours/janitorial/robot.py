@@ -10,7 +10,11 @@ motivation, eq. (3.1) of :mod:`teamsim.controllers.alliance.motivation`, so the 
   it passes to the behaviour set (:class:`~teamsim.controllers.behaviours.janitorial.dusting.DustClaims`);
 - ``clean-floor q`` for each quadrant q: applicable until q is completed (by this robot or a teammate heard); a
   teammate's "cleaning quadrant q" slows it. The set first circles the room if this robot does not know its size,
-  broadcasting "finding room dimensions" meanwhile.
+  broadcasting "finding room dimensions" meanwhile;
+- ``verify-dusting`` and ``verify-floor`` (§6.2.1, "Confirmation of completed tasks"): low priority and very slow
+  impatience, applicable once every object (quadrant) is believed done and one is not yet verified by anyone
+  heard. Verification here is doing it again: the duster goes back to the object and circles it, the cleaner
+  covers the quadrant afresh (a robot has no sensor that tells a dusted surface or a clean floor).
 
 Broadcasts say what the robot does (the messages of §6.2.1) and carry its completions so far (objects dusted,
 quadrants cleaned), so a completion is not lost when the next message slot comes after the robot has moved on.
@@ -35,6 +39,7 @@ from teamsim.models.janitor import CLEAN, DUST, EMPTY, TOOL_OF_TASK
 from teamsim.models.robot import RobotModel
 
 DUSTING, FINDING_ROOM = "dusting furniture", "finding room dimensions"  # announcements no set listens to
+VERIFY_DUST, VERIFY_FLOOR = "verify-dusting", "verify-floor"
 
 
 @dataclass(frozen=True)
@@ -60,6 +65,9 @@ class JanitorParams:
     floor_rates: SetRates = field(default_factory=lambda: SetRates(delta_slow=1 / 150, phi=150.0, psi=20.0,
                                                                    lam=400.0), metadata={
         "meaning": "each quadrant's set: a teammate cleaning it is given phi s"})
+    verify_rates: SetRates = field(default_factory=lambda: SetRates(
+        delta_fast=1 / 60, delta_slow=1 / 600, phi=600.0, psi=60.0, lam=600.0), metadata={
+        "meaning": "the verification sets: very slow impatience (§6.2.1, 'Confirmation of completed tasks')"})
     threshold: float = setting(1.0, lo=0.0, open_lo=True, meaning="theta (§3.6)")
     garbage: GarbageParams = field(default_factory=GarbageParams, metadata={"meaning": "empty-garbage constants"})
     dusting: DustParams = field(default_factory=DustParams, metadata={"meaning": "dust-furniture constants"})
@@ -96,7 +104,13 @@ class JanitorRobot:
             for q in QUADRANTS:
                 sets.append(BehaviourSet(f"{CLEAN} {q}", rates=params.floor_rates.motivation()))
                 self.behaviours[sets[-1].name] = (self.floor, q)
+        for task, name in ((DUST, VERIFY_DUST), (CLEAN, VERIFY_FLOOR)):  # lowest priority: after every task
+            if task in tasks:
+                sets.append(BehaviourSet(name, rates=params.verify_rates.motivation()))
+                self.behaviours[name] = (self.dust if task == DUST else self.floor, "")
         self.tasks = tasks
+        self.verified_floor: set[str] = set()
+        self.verified_dust: list[np.ndarray] = []
         self.phi = {s.name: s.rates.phi for s in sets}
         self.name = robot.name
         self.alliance = AllianceRobot(robot.name, sets, AllianceParams(threshold=params.threshold, tau=tau),
@@ -112,6 +126,9 @@ class JanitorRobot:
             self.began[message.sender] = (payload.get("task"), float(payload.get("since", obs.time)))
             done = payload.get("done", {})
             self.quadrants_done.update(done.get("floor", ()))
+            self.verified_floor.update(done.get("floor_verified", ()))
+            for at in done.get("dust_verified", ()):
+                self._verified_object(at)
             if DUST in self.tasks:
                 for at in done.get("dust", ()):
                     self.claims.completed(at)
@@ -125,9 +142,26 @@ class JanitorRobot:
                 feedback[name] = self.garbage.heard(obs, sub_task)
             elif name == DUST:
                 feedback[name] = len(self.claims.done) < self.objects
+            elif name == VERIFY_DUST:
+                feedback[name] = len(self.claims.done) >= self.objects and self._unverified_object() is not None
+            elif name == VERIFY_FLOOR:
+                feedback[name] = self.quadrants_done >= set(QUADRANTS) and self._unverified_quadrant() is not None
             else:
                 feedback[name] = sub_task not in self.quadrants_done
         return feedback
+
+    def _unverified_quadrant(self) -> str | None:
+        return next((q for q in QUADRANTS if q not in self.verified_floor), None)
+
+    def _unverified_object(self) -> np.ndarray | None:
+        near = self.params.dusting.same_object
+        return next((at for at in self.claims.done
+                     if all(np.hypot(*(at - v)) > near for v in self.verified_dust)), None)
+
+    def _verified_object(self, at) -> None:
+        location = np.asarray(at, float)
+        if all(np.hypot(*(location - v)) > self.params.dusting.same_object for v in self.verified_dust):
+            self.verified_dust.append(location)
 
     def _precedes(self, task: str, teammate: str) -> bool:
         """Whether psi yields ``task`` to ``teammate``: first come, first served, unless the later one came after
@@ -151,7 +185,12 @@ class JanitorRobot:
         active, trace = self.alliance.step(obs.time, self._feedback(obs), obs.inbox, obs.robots_present)
         if active is not None and active != self.active:
             behaviour, sub_task = self.behaviours[active]
-            behaviour.start(sub_task, obs.time)
+            if active == VERIFY_FLOOR:
+                self.floor.start(self._unverified_quadrant(), obs.time, verify=True)
+            elif active == VERIFY_DUST:
+                self.dust.start("", obs.time, verify_at=self._unverified_object())
+            else:
+                behaviour.start(sub_task, obs.time)
         self.active = active
         if active is None:
             return Command(behaviour="idle", extras=dict(self.tools), trace=trace, broadcast=self._message(None))
@@ -167,8 +206,11 @@ class JanitorRobot:
         if DUST in self.tasks:
             for at in self.dust.finished:
                 self.claims.completed(at)
+            for at in self.dust.verified:
+                self._verified_object(at)
         if CLEAN in self.tasks:
             self.quadrants_done.update(self.floor.completed)
+            self.verified_floor.update(self.floor.verified)
 
     def _message(self, active: str | None) -> dict:
         """The activity broadcast (§6.2.1's messages) with this robot's completions."""
@@ -177,6 +219,10 @@ class JanitorRobot:
             done["dust"] = [[round(float(v), 2) for v in at] for at in self.dust.finished]
         if CLEAN in self.tasks and self.floor.completed:
             done["floor"] = list(self.floor.completed)
+        if CLEAN in self.tasks and self.floor.verified:
+            done["floor_verified"] = list(self.floor.verified)
+        if DUST in self.tasks and self.dust.verified:
+            done["dust_verified"] = [[round(float(v), 2) for v in at] for at in self.dust.verified]
         message = {"task": active, "done": done, "since": round(self.alliance.active_since, 3)}
         if active == DUST:
             at = self.dust.dusting_at

@@ -1,0 +1,292 @@
+"""``teamsim study janitorial-rho``: Parker's communication-rate study on the janitorial service (§6.2.3, Fig. 6-13).
+
+The ``janitorial`` mission at each broadcast rate rho (broadcasts per second per robot; 0: no messages at all), the
+same ``missions`` seeds at every rho, so rates are compared mission by mission. The metric is mission completion
+time. A run that did not complete has no mission time: its time is censored at the duration, and the report says
+how many runs completed and when a mean over the completed ones is biased.
+"""
+from __future__ import annotations
+
+import math
+import warnings
+from dataclasses import dataclass
+from pathlib import Path
+
+import cv2
+import numpy as np
+from scipy.stats import wilcoxon
+
+from teamsim.config import TrialConfig
+from teamsim.files import write_atomic, write_csv
+from teamsim.sweep import run_trials
+from teamsim.tasks.missions.janitorial import JanitorialMission, JanitorialParams
+from teamsim.tasks.studies.findings import Finding, verdict
+
+COLUMNS = ("rho", "mission", "seed", "status", "completed", "mission_time_s", "cans_emptied", "cans",
+           "objects_dusted", "objects", "floor_cleaned", "real_time_factor")
+MIN_COMPLETED = 5  # completed runs each rho needs before its mean is compared
+THESIS_RHO0_MEAN = 438  # time units of Parker's simulator, 10 runs (§6.2.3)
+# (rho a, rho b) -> (the thesis's words, the range of b's change against a, in %, that reproduces them "as worded")
+THESIS_STEPS = {(0.0, 0.1): ("about 22 % less time", (-33.0, -11.0)),
+                (0.1, 0.5): ("a further 10 % less", (-15.0, -5.0)),
+                (0.5, 2.0): ('"not getting closer to the optimal"', (-5.0, math.inf))}
+
+
+@dataclass(frozen=True)
+class JanitorialRhoStudy:
+    rhos: tuple[float, ...] = (0.0, 0.1, 0.5, 2.0)
+    missions: int = 10
+    seed: int = 0
+    workers: int | None = None
+    out: Path = Path("renders/study-janitorial-rho")
+    duration: float | None = None
+
+
+def rhos_of(study: JanitorialRhoStudy) -> list[float]:
+    """The study's rates, each once, in increasing order (the order consecutive rates are compared in)."""
+    return sorted({float(rho) for rho in study.rhos})
+
+
+def duration_of(study: JanitorialRhoStudy) -> float:
+    """Simulated seconds per mission: where a run that did not complete is censored."""
+    return study.duration or JanitorialMission.default_duration
+
+
+def trial_configs(study: JanitorialRhoStudy) -> list[TrialConfig]:
+    configs = []
+    for rho in rhos_of(study):
+        for k in range(study.missions):
+            config = TrialConfig(mission="janitorial", params=JanitorialParams(rho=rho), seed=study.seed + k,
+                                 duration=study.duration, out=str(study.out / "trials"), run_id=f"rho{rho:g}-{k}")
+            config.video.fps = 2  # the trajectory of a study mission is for inspection, not for video
+            configs.append(config)
+    return configs
+
+
+def result_row(config: TrialConfig, summary: dict) -> dict:
+    """One run's row; ``mission_time_s`` only for a completed run (any other has no mission time)."""
+    metrics = summary.get("metrics") or {}
+    completed = bool(summary.get("completed", False))
+    row = {"rho": config.params.rho, "mission": int(config.run_id.rsplit("-", 1)[1]), "seed": config.seed,
+           "status": summary["status"], "completed": completed,
+           "mission_time_s": metrics.get("mission_time_s") if completed else None,
+           "real_time_factor": summary.get("real_time_factor")}
+    for key in ("cans_emptied", "cans", "objects_dusted", "objects", "floor_cleaned"):
+        row[key] = metrics.get(key)
+    return row
+
+
+def run_study(study: JanitorialRhoStudy) -> Path:
+    configs = trial_configs(study)
+    return write_results(study, configs, run_trials(configs, workers=study.workers))
+
+
+def write_results(study: JanitorialRhoStudy, configs: list[TrialConfig], summaries: list[dict]) -> Path:
+    """``results.csv``, ``times.png`` and ``report.md`` in ``study.out`` from the trials' summaries."""
+    rows = [result_row(c, s) for c, s in zip(configs, summaries)]
+    study.out.mkdir(parents=True, exist_ok=True)
+    write_csv(study.out / "results.csv", COLUMNS, rows)
+    write_atomic(study.out / "report.md", report(study, rows).encode())
+    plot_times(study.out / "times.png", rows, rhos_of(study), duration_of(study))
+    return study.out
+
+
+# -- statistics ---------------------------------------------------------------------------------------------------
+def times(rows: list[dict], rho: float) -> dict[int, float]:
+    """Mission time per seed of the runs at ``rho`` that completed."""
+    return {r["seed"]: r["mission_time_s"] for r in rows if r["rho"] == rho and r["completed"]
+            and r["mission_time_s"] is not None}
+
+
+def at(rows: list[dict], rho: float) -> list[dict]:
+    return [r for r in rows if r["rho"] == rho]
+
+
+def mean_sd(values) -> tuple[float, float]:
+    values = list(values)
+    mean = float(np.mean(values)) if values else math.nan
+    return mean, float(np.std(values, ddof=1)) if len(values) > 1 else math.nan
+
+
+def wilcoxon_p(a: list[float], b: list[float]) -> float:
+    """Two-sided p of the Wilcoxon signed-rank test on the pairs (a_i, b_i); nan with fewer than two pairs."""
+    if len(a) < 2:
+        return math.nan
+    if all(x == y for x, y in zip(a, b)):
+        return 1.0
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)
+        return float(wilcoxon(a, b).pvalue)
+
+
+def step(rows: list[dict], a: float, b: float) -> dict:
+    """Rho a against rho b: the ratio of their mean times (completed runs), the pairs both completed, their p."""
+    first, second = times(rows, a), times(rows, b)
+    seeds = sorted(set(first) & set(second))
+    ratio = mean_sd(second.values())[0] / mean_sd(first.values())[0] if first and second else math.nan
+    few = min(len(first), len(second)) < MIN_COMPLETED
+    return {"ratio": ratio, "pairs": len(seeds), "few": few,
+            "biased": any(not r["completed"] for r in at(rows, a) + at(rows, b)),
+            "p": wilcoxon_p([first[s] for s in seeds], [second[s] for s in seeds])}
+
+
+def claims(rows: list[dict], rhos: list[float]) -> list[tuple[Finding, int | None]]:
+    """The thesis's statements about the rates this study ran, each with teamsim's figure, p, verdict and the
+    number of missions the p is over (None: no comparison)."""
+    found = []
+    if 0.0 in rhos:
+        done, runs = times(rows, 0.0), len(at(rows, 0.0))
+        figure = f"{len(done)}/{runs} completed"
+        if done:
+            figure += f", mean {mean_sd(done.values())[0]:.0f} s" + (" (biased low)" if len(done) < runs else "")
+        judged = ("too few completed runs to decide" if runs < MIN_COMPLETED else
+                  verdict(int(len(done) == runs), 1) if len(done) in (0, runs) else "partly")
+        found.append((Finding("rho = 0 (no messages): the mission still completes",
+                              f"every run completed, mean {THESIS_RHO0_MEAN} time units", figure, judged), None))
+    for a, b in zip(rhos, rhos[1:]):
+        words, (lo, hi) = THESIS_STEPS.get((a, b), ("-", (math.nan, math.nan)))
+        s = step(rows, a, b)
+        change = 100 * (s["ratio"] - 1)
+        figure = "no mean" if math.isnan(change) else f"x{s['ratio']:.2f} ({change:+.0f} %)"
+        if s["biased"] and not math.isnan(change):
+            figure += ", biased: not every run completed"
+        if s["few"]:
+            judged = "too few completed runs to decide"
+        elif words == "-":
+            judged = "n/a"
+        elif lo <= change <= hi:
+            judged = "yes"
+        else:
+            judged = "partly" if hi < 0 and change < 0 else "**no**"
+        found.append((Finding(f"rho {a:g} -> {b:g}: mean mission time", words, figure, judged, s["p"]), s["pairs"]))
+    return found
+
+
+# -- report -------------------------------------------------------------------------------------------------------
+def report(study: JanitorialRhoStudy, rows: list[dict]) -> str:
+    rhos, duration = rhos_of(study), duration_of(study)
+    lines = ["# Communication-rate study (Parker §6.2.3, Fig. 6-13) re-run in teamsim", "",
+             f"{study.missions} missions per rate (the thesis: 10), seeds {study.seed}.."
+             f"{study.seed + study.missions - 1} at every rate. rho = broadcasts per second per robot; rho = 0: every "
+             "robot's radio off from t = 0 (no messages at all). Mission time = simulated seconds until every can is "
+             "emptied, every object dusted and the share `task.floor_share` of the floor cleaned. A run that did "
+             f"not complete in its {duration:g} s has no mission time: it is censored at {duration:g} s. Per-mission "
+             "rows: `results.csv`.", "",
+             "## Mission time per rate", "",
+             "Mean and s.d. over the runs that completed. Where some did not, that mean leaves the slowest missions "
+             f"out and is **biased low**; \"lower bound\" counts each run that ran out of time at {duration:g} s "
+             f"(those runs needed longer). Fewer than {MIN_COMPLETED} completed runs: too few to decide.", "",
+             "| rho | n | completed | mean time (s) | s.d. (s) | not completed | lower bound (s) | note |",
+             "|---|---|---|---|---|---|---|---|"]
+    for rho in rhos:
+        runs, done = at(rows, rho), times(rows, rho)
+        mean, sd = mean_sd(done.values())
+        timed_out = [r for r in runs if r["status"] == "failed"]
+        other = [r for r in runs if not r["completed"] and r["status"] != "failed"]
+        missing = [f"{len(timed_out)} ran out of time"] if timed_out else []
+        missing += [f"{len(other)} ended in error ({', '.join(sorted({r['status'] for r in other}))})"] if other else []
+        bound = mean_sd([*done.values(), *[duration] * len(timed_out)])[0] if timed_out and not other else math.nan
+        notes = [] if len(done) >= MIN_COMPLETED else ["too few completed runs to decide"]
+        notes += [f"mean biased low ({len(runs) - len(done)} of {len(runs)} runs left out)"] if 0 < len(done) < len(
+            runs) else []
+        lines.append(f"| {rho:g} | {len(runs)} | {len(done)} | {_number(mean)} | {_number(sd)} | "
+                     f"{', '.join(missing) or '-'} | {_number(bound)} | {'; '.join(notes) or '-'} |")
+    lines += ["", "## Against the thesis", "",
+              "Change = the mean time at the second rate over the mean at the first (completed runs of each), as a "
+              "ratio and in %. p: two-sided Wilcoxon signed-rank test (scipy.stats.wilcoxon, exact for small samples) "
+              "on the missions both rates completed (pairs: how many; with fewer than 6 pairs p cannot fall below "
+              "0.05). **yes** where the thesis's figure holds as worded (22 %: a reduction of 11-33 %; 10 %: 5-15 %; "
+              "\"not getting closer\": less than 5 % faster), **partly** where the time falls but by another amount, "
+              f"**no** otherwise; fewer than {MIN_COMPLETED} completed runs at either rate: too few completed runs to "
+              "decide. A reduction with p >= 0.05 is not decided by this sample. The thesis's time units are its "
+              "simulator's, not seconds: only its ratios compare.", "",
+              "| claim | thesis | teamsim | pairs | p (Wilcoxon) | reproduced |", "|---|---|---|---|---|---|"]
+    for found, pairs in claims(rows, rhos):
+        undecided = pairs is not None and found.verdict in ("yes", "partly") and "not getting" not in found.thesis \
+            and not found.p < 0.05
+        lines.append(f"| {found.claim} | {found.thesis} | {found.teamsim} | {'-' if pairs is None else pairs} | "
+                     f"{'-' if math.isnan(found.p) else f'{found.p:.2g}'} | "
+                     f"{found.verdict}{', not decided by this sample' if undecided else ''} |")
+    lines += ["", "![mission time per rate](times.png)", "", "## Why teamsim may differ", "", DIFFERENCES]
+    return "\n".join(lines) + "\n"
+
+
+def _number(value: float) -> str:
+    return "-" if math.isnan(value) else f"{value:.0f}"
+
+
+DIFFERENCES = """\
+- Parker's times are in her simulator's time units; teamsim's are simulated seconds of MuJoCo physics. Only the
+  ratios between rates compare.
+- Her "optimal" reference came from hand-engineering every parameter and is given in Fig. 6-13 only; teamsim does
+  not reproduce it, so "not getting closer to the optimal" is checked as: rho = 2 is less than 5 % faster than
+  rho = 0.5.
+- The room, its cans, objects and obstacles are drawn from the seed (the same rooms at every rate); Parker's
+  variance came from sensor and effector noise in her simulator.
+"""
+
+
+# -- figure -------------------------------------------------------------------------------------------------------
+LEFT, RIGHT, TOP, BOTTOM = 60, 20, 40, 70  # px around the plot
+BLACK, GREY, BLUE, RED = (0, 0, 0), (120, 120, 120), (180, 119, 31), (40, 39, 214)  # BGR
+FONT = cv2.FONT_HERSHEY_SIMPLEX
+
+
+def nice_step(span: float) -> float:
+    """The smallest 1, 2, 2.5 or 5 x 10^k at least ``span``."""
+    power = 10.0 ** math.floor(math.log10(span))
+    return next(m * power for m in (1.0, 2.0, 2.5, 5.0, 10.0) if m * power >= span)
+
+
+def plot_times(path: Path, rows: list[dict], rhos: list[float], duration: float, width: int = 900,
+               height: int = 420) -> None:
+    """Fig. 6-13's form: each run's mission time at each rate, the mean of the completed runs marked; a run that
+    did not complete is drawn hollow at the duration, where its time is censored (an errored run is not drawn)."""
+    finished = [r["mission_time_s"] for r in rows if r["completed"] and r["mission_time_s"] is not None]
+    censored = any(r["status"] == "failed" for r in rows)
+    top = 1.05 * max([*finished, *([duration] if censored or not finished else [])])
+    tick = nice_step(top / 5)
+    ticks = math.ceil(top / tick)
+    image = np.full((height, width, 3), 255, np.uint8)
+
+    def y_of(value: float) -> int:
+        return int(TOP + (height - TOP - BOTTOM) * (1 - value / (ticks * tick)))
+
+    def text(words: str, at: tuple[int, int], scale: float = 0.4, colour=BLACK) -> None:
+        cv2.putText(image, words, at, FONT, scale, colour, 1, cv2.LINE_AA)
+
+    text("Mission time per rate rho (Parker Fig. 6-13)", (LEFT, 26), 0.6)
+    for k in range(ticks + 1):
+        cv2.line(image, (LEFT, y_of(k * tick)), (width - RIGHT, y_of(k * tick)), (225, 225, 225), 1)
+        text(f"{k * tick:g}", (8, y_of(k * tick) + 4))
+    text("time (s)", (8, TOP - 12))
+    if censored:
+        cv2.line(image, (LEFT, y_of(duration)), (width - RIGHT, y_of(duration)), GREY, 1, cv2.LINE_AA)
+        text(f"duration {duration:g} s", (LEFT + 4, y_of(duration) - 8), colour=GREY)
+    column = (width - LEFT - RIGHT) / max(len(rhos), 1)
+    for c, rho in enumerate(rhos):
+        centre = LEFT + column * (c + 0.5)
+        runs = sorted(at(rows, rho), key=lambda r: r["seed"])
+        for k, r in enumerate(runs):
+            x = int(centre + column * 0.5 * ((k + 0.5) / len(runs) - 0.5))  # the runs spread across the column
+            if r["completed"] and r["mission_time_s"] is not None:
+                cv2.circle(image, (x, y_of(r["mission_time_s"])), 4, BLUE, -1, cv2.LINE_AA)
+            elif r["status"] == "failed":
+                cv2.circle(image, (x, y_of(duration)), 4, RED, 1, cv2.LINE_AA)
+        mean = mean_sd(times(rows, rho).values())[0]
+        if not math.isnan(mean):
+            half = int(column * 0.35)
+            cv2.line(image, (int(centre) - half, y_of(mean)), (int(centre) + half, y_of(mean)), BLACK, 2, cv2.LINE_AA)
+        text(f"rho = {rho:g}", (int(centre) - 30, height - BOTTOM + 18), 0.45)
+        text(f"{len(times(rows, rho))}/{len(runs)} completed", (int(centre) - 45, height - BOTTOM + 36), colour=GREY)
+    cv2.line(image, (LEFT, y_of(0)), (width - RIGHT, y_of(0)), BLACK, 1)
+    legend = height - 12
+    cv2.circle(image, (LEFT + 6, legend - 4), 4, BLUE, -1, cv2.LINE_AA)
+    text("completed run", (LEFT + 16, legend))
+    cv2.circle(image, (LEFT + 156, legend - 4), 4, RED, 1, cv2.LINE_AA)
+    text("not completed (censored at the duration)", (LEFT + 166, legend))
+    cv2.line(image, (LEFT + 486, legend - 4), (LEFT + 506, legend - 4), BLACK, 2)
+    text("mean of the completed runs", (LEFT + 514, legend))
+    ok, png = cv2.imencode(".png", image)
+    if ok:
+        write_atomic(path, png.tobytes())
