@@ -123,3 +123,6 @@ def test_every_package_is_installed():
     on_disk = {name for name, path in modules({p: ROOT / d for p, d in PACKAGE_DIRS.items()}).items()
                if path.name == "__init__.py"}
     assert on_disk == listed
+    # A folder of modules without __init__.py would import in an editable install and be dropped by ``pip install .``
+    folders = {path.parent for path in modules({p: ROOT / d for p, d in PACKAGE_DIRS.items()}).values()}
+    assert not [str(f.relative_to(ROOT)) for f in folders if not (f / "__init__.py").exists()]
