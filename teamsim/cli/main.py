@@ -128,8 +128,8 @@ def _build_parser() -> argparse.ArgumentParser:
     _run_options(boxes, workers=2, out="renders/study-box-pushing")
 
     bench = commands.add_parser("bench", help="benchmarks")
-    bench.add_argument("what", choices=("physics", "cleanup", "box-pushing", "render", "nav", "alliance", "allocate",
-                                        "sweep", "explore"))
+    bench.add_argument("what", choices=("physics", "cleanup", "box-pushing", "janitorial", "render", "nav", "alliance",
+                                        "allocate", "sweep", "explore"))
     bench.add_argument("--seconds", type=float, default=None, help="simulated seconds per measurement")
     return parser
 
@@ -365,6 +365,8 @@ def cmd_bench(args) -> int:
         bench.cleanup(seconds=args.seconds or 300.0)
     elif args.what == "box-pushing":
         bench.box_pushing(seconds=args.seconds or 120.0)
+    elif args.what == "janitorial":
+        bench.janitorial(seconds=args.seconds or 300.0)
     else:
         from teamsim.bench.video import video_cost
 
