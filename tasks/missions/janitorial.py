@@ -38,7 +38,8 @@ TEAM = {"r1": ("empty-garbage", "dust-furniture"), "r2": ("empty-garbage", "clea
         "r3": ("dust-furniture", "clean-floor")}  # Fig. 6-12
 FREQUENCY_RGBA = [(0.9, 0.2, 0.2, 1), (0.2, 0.5, 0.95, 1), (0.95, 0.8, 0.1, 1), (0.6, 0.3, 0.85, 1),
                   (0.2, 0.8, 0.6, 1), (1.0, 0.5, 0.1, 1)]
-EMPTIED_RGBA, DUSTED_RGBA, FURNITURE_RGBA = (0.55, 0.55, 0.55, 1), (0.95, 0.9, 0.75, 1), (0.55, 0.35, 0.2, 1)
+FURNITURE_RGBA = (0.55, 0.35, 0.2, 1)
+DIMS = JanitorDims()  # the janitors' dimensions: the tools' footprints the ground truth measures
 GAP = 0.7  # m kept free between things in the room and from the walls: room for a janitor to pass and circle
 FLOOR_CELL = 0.05  # m: the ground-truth floor raster
 LAYOUT_ATTEMPTS = 50
@@ -197,15 +198,14 @@ class JanitorialMission(ScenarioMission):
         furniture = [(f.x, f.y, f.half_x, f.half_y, f.yaw) for f in task.furniture]
         discs = [(c.x, c.y, task.can_radius) for c in task.cans]
         floor = Floor(size, FLOOR_CELL, rasterise(size, FLOOR_CELL, boxes + furniture, discs))
-        dims = JanitorDims()
         starts = np.array([r.pose[:2] for n, r in scenario.robots.items() if n not in dict(newcomers)])
-        floor.settle_reachable(dims.radius + 0.02, starts, dims.cleaner_half_depth)
+        floor.settle_reachable(DIMS.radius + 0.02, starts, DIMS.cleaner_half_depth)
         cans = Cans([Can(c.x, c.y, task.can_radius, c.frequency, c.appears) for c in task.cans], task.empty_time,
                     reach=0.05)
         scene.info.update(
             floor=floor, cans=cans, brains={}, time=0.0, sound={},
             furniture=Furniture(furniture, floor, spacing=0.1, reach=0.06, share=task.dust_share,
-                                clearance=2 * dims.radius + 0.05))
+                                clearance=2 * DIMS.radius + 0.05))
         return scene
 
     def controller(self, robot: RobotModel, scene: Scene, rng: np.random.Generator):
@@ -252,15 +252,8 @@ class JanitorialMission(ScenarioMission):
                 info["furniture"].sweep(data.body(f"{name}/duster").xpos[:2], data.site(f"{name}/duster_tip").xpos[:2],
                                         world.time)
             if tools.get("cleaner", 0.0) > 0.8:
-                dims = JanitorDims()
                 info["floor"].clean(data.site(f"{name}/cleaner").xpos[:2], world.pose(robot)[2],
-                                    dims.cleaner_half_depth, dims.cleaner_half_width)
-        for k, can in enumerate(info["cans"].cans):
-            if can.emptied_at is not None:
-                world.model.geom(f"emitter{k}").rgba[:] = EMPTIED_RGBA
-        for k, done in enumerate(info["furniture"].done_at):
-            if done is not None:
-                world.model.geom(f"furniture{k}").rgba[:] = DUSTED_RGBA
+                                    DIMS.cleaner_half_depth, DIMS.cleaner_half_width)
 
     # -- pictures ------------------------------------------------------------------------------------------------------
     def _picture(self, world) -> np.ndarray:
