@@ -4,10 +4,12 @@ from __future__ import annotations
 
 from teamsim.tasks.missions.box_pushing import BoxPushingMission
 from teamsim.tasks.missions.explore import ExploreMission
+from teamsim.tasks.missions.formation import FormationMission
 from teamsim.tasks.missions.hazardous_waste import HazardousWasteMission
 from teamsim.tasks.missions.janitorial import JanitorialMission
 from teamsim.tasks.missions.navigate import NavigateMission
 from teamsim.tasks.missions.wander import WanderMission
 
 MISSIONS = {mission.name: mission for mission in (WanderMission(), NavigateMission(), HazardousWasteMission(),
-                                                     BoxPushingMission(), ExploreMission(), JanitorialMission())}
+                                                     BoxPushingMission(), ExploreMission(), JanitorialMission(),
+                                                     FormationMission())}

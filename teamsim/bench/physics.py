@@ -189,6 +189,22 @@ def janitorial(seconds: float = 300.0, seed: int = 0, repeats: int = 2) -> dict:
     return mission_speed(config, seconds, repeats)
 
 
+def formation(seconds: float = 120.0, seed: int = 0, repeats: int = 2) -> dict:
+    """Keeping formation: four robots in line under strategy IV, and a crossing team of two."""
+    config = TrialConfig(mission="formation", params=MISSIONS["formation"].Params(crossing=2), seed=seed)
+    print(f"bench formation: A-D in line (strategy IV) and X1, X2 crossing, seed {seed}, {seconds:g} s simulated, "
+          f"full control stack, no video, best of {repeats}")
+    return mission_speed(config, seconds, repeats)
+
+
+def overwatch(seconds: float = 120.0, seed: int = 0, repeats: int = 2) -> dict:
+    """Bounding overwatch's eight robots (issue 27's target: >= 15x real time)."""
+    config = TrialConfig(mission="bounding-overwatch", params=MISSIONS["bounding-overwatch"].Params(), seed=seed)
+    print(f"bench bounding-overwatch: 8 robots, seed {seed}, {seconds:g} s simulated, full control stack, no video, "
+          f"best of {repeats}")
+    return mission_speed(config, seconds, repeats, target=15.0)
+
+
 def mission_speed(config: TrialConfig, seconds: float, repeats: int, target: float = 20.0) -> dict:
     """A mission's full control stack, no video, best of ``repeats``; and bare ``mj_step`` from the state a run
     ended in (its controls held), the most the stack could reach."""

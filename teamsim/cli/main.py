@@ -17,6 +17,7 @@ from teamsim.gl import RenderBackendError
 CLEANUP_CONDITIONS = ("none", "kill-red", "radio-off", "break-gripper")
 BOX_EXPERIMENTS = ("robot-failure", "heterogeneity")  # teamsim.tasks.studies.box_pushing.EXPERIMENTS
 JANITORIAL_RHOS = (0.0, 0.1, 0.5, 2.0)  # teamsim.tasks.studies.janitorial_rho.JanitorialRhoStudy.rhos
+FORMATION_STRATEGIES = ("I", "II", "III", "IV")  # teamsim.controllers.behaviours.formation.STRATEGIES
 
 EXIT_USAGE = 2
 
@@ -127,9 +128,18 @@ def _build_parser() -> argparse.ArgumentParser:
                        help=f"comma-separated: {','.join(BOX_EXPERIMENTS)}")
     _run_options(boxes, workers=2, out="renders/study-box-pushing")
 
+    formation = studies.add_parser("formation", help="Parker §7.2: keeping formation under strategies I-IV "
+                                                     "(Fig. 7-2)")
+    formation.add_argument("--runs", type=_positive_int("--runs"), default=10,
+                           help="runs per strategy (the thesis: 10)")
+    formation.add_argument("--strategies", type=_csv_of("strategy", FORMATION_STRATEGIES),
+                           default=FORMATION_STRATEGIES, help=f"comma-separated: {','.join(FORMATION_STRATEGIES)}")
+    formation.add_argument("--duration", type=float, help="simulated seconds per run (mission default if unset)")
+    _run_options(formation, workers=2, out="renders/study-formation")
+
     bench = commands.add_parser("bench", help="benchmarks")
-    bench.add_argument("what", choices=("physics", "cleanup", "box-pushing", "janitorial", "render", "nav", "alliance",
-                                        "allocate", "sweep", "explore"))
+    bench.add_argument("what", choices=("physics", "cleanup", "box-pushing", "janitorial", "formation", "overwatch",
+                                        "render", "nav", "alliance", "allocate", "sweep", "explore"))
     bench.add_argument("--seconds", type=float, default=None, help="simulated seconds per measurement")
     return parser
 
@@ -230,6 +240,14 @@ def cmd_study(args) -> int:
         out = run_study(BoxPushingStudy(trials=args.trials, seed=args.seed, experiments=args.experiments,
                                         workers=args.workers, out=args.out))
         print(f"wrote {out / 'report.md'} and {out / 'results.csv'}")
+    elif args.study == "formation":
+        if args.duration is not None and not args.duration > 0:
+            raise ConfigError("--duration: must be > 0 simulated seconds")
+        from teamsim.tasks.studies.formation import FormationStudy, run_study
+
+        out = run_study(FormationStudy(runs=args.runs, seed=args.seed, strategies=args.strategies,
+                                       workers=args.workers, out=args.out, duration=args.duration))
+        print(f"wrote {out / 'report.md'}, {out / 'fig7-2.png'} and {out / 'results.csv'}")
     elif args.study == "lalliance":
         from teamsim.tasks.studies.lalliance import run_study
 
@@ -311,6 +329,7 @@ def cmd_list(_args) -> int:
     print("  janitorial-rho   Parker §6.2.3: the janitorial service's mission time at broadcast rates rho")
     print("  cleanup-faults   Parker §3.8.4: the cleanup with red killed, the radio off, a gripper broken")
     print("  box-pushing      Parker §6.1.2: an R-2 taken away and returned; an R-2 replaced by Genghis-II")
+    print("  formation        Parker §7.2: keeping formation under strategies I-IV (Fig. 7-2)")
     return 0
 
 
@@ -367,6 +386,10 @@ def cmd_bench(args) -> int:
         bench.box_pushing(seconds=args.seconds or 120.0)
     elif args.what == "janitorial":
         bench.janitorial(seconds=args.seconds or 300.0)
+    elif args.what == "formation":
+        bench.formation(seconds=args.seconds or 120.0)
+    elif args.what == "overwatch":
+        bench.overwatch(seconds=args.seconds or 120.0)
     else:
         from teamsim.bench.video import video_cost
 
