@@ -11,8 +11,10 @@ the positioning model's noise, every positioning period (:meth:`FormationMission
 Metric (§7.2): ``fe_t``, the sum over non-leaders of the distance to the proper place given the leader's current
 pose (``leader + o_i`` across its heading), sampled at integer seconds; the normalised cumulative formation error
 ``cum_fe / t_max``; and the mission time ``t_max``: when the leader has reached the last waypoint and every robot
-is within ``task.settle`` of its place. Also measured: seconds a follower spent turned round (heading more than
-120 degrees off the leader's) and seconds the line's left-to-right order was broken.
+is within ``task.settle`` of its place. §7.2 does not say which way the line is laid across the leader: the
+"route reading" (``fe_route``, ``normalised_error_route``) lays it across the leader's current leg of the route
+instead of its heading (docs/decisions.md, "Keeping formation"). Also measured: seconds a follower spent turned
+round (heading more than 120 degrees off the leader's) and seconds the line's left-to-right order was broken.
 """
 from __future__ import annotations
 
@@ -25,8 +27,8 @@ import cv2
 import numpy as np
 
 from teamsim.config import ConfigError, RadioConfig, setting
-from teamsim.controllers.behaviours.formation import (SIGNAL, STRATEGIES, KeepFormation, KeepFormationParams, Line,
-                                                      RouteLeader, normal)
+from teamsim.controllers.behaviours.formation import (SIGNAL, STRATEGIES, KeepFormation, KeepFormationParams, Lanes,
+                                                      Line, RouteLeader, normal)
 from teamsim.models.robot import RobotModel
 from teamsim.positioning import wrap_angle
 from teamsim.scenario import Arena, BoxObstacle, RobotEntry, Scenario, Spot, scene_of
@@ -256,7 +258,8 @@ class FormationMission(ScenarioMission):
                      rgba=[0.9, 0.4, 0.1, 1], contype=0, conaffinity=0)
         line = Line(tuple(task.line), task.leader, task.spacing)
         scene.info.update(line=line, route=route, brains={}, sensed={}, sense_rng={}, errors=[], distances=[],
-                          tracks={n: [] for n in scenario.robots}, turned_round_s=0, order_broken_s=0)
+                          route_errors=[], lanes=Lanes(route), leg=0, tracks={n: [] for n in scenario.robots},
+                          turned_round_s=0, order_broken_s=0)
         return scene
 
     def controller(self, robot: RobotModel, scene: Scene, rng: np.random.Generator):
@@ -303,24 +306,29 @@ class FormationMission(ScenarioMission):
         return {SIGNAL: readings}
 
     # -- the metric, at integer seconds --------------------------------------------------------------------------------
-    def places(self, world) -> dict[str, tuple[np.ndarray, np.ndarray]]:
-        """(true position, proper place given the leader's current pose) of every robot of the line."""
+    def places(self, world, across: float | None = None) -> dict[str, tuple[np.ndarray, np.ndarray]]:
+        """(true position, proper place) of every robot of the line: the place given the leader's current pose,
+        across its heading or, given ``across``, across that heading (the route reading: the leader's leg)."""
         line: Line = world.scene.info["line"]
         lead = world.pose(world.robots[line.leader])
-        return {n: (world.pose(world.robots[n])[:2], lead[:2] + line.offset(n) * normal(lead[2])) for n in line.names}
+        side = normal(lead[2] if across is None else across)
+        return {n: (world.pose(world.robots[n])[:2], lead[:2] + line.offset(n) * side) for n in line.names}
 
     def _measure(self, world) -> None:
         info = world.scene.info
         if world.time + 1e-6 < len(info["errors"]):
             return
         line: Line = info["line"]
+        lead = world.pose(world.robots[line.leader])
+        info["leg"] = info["lanes"].leg_of(info["leg"], lead[:2], float(lead[2]), 1.0)
         places = self.places(world)
         distances = {n: float(np.linalg.norm(p - q)) for n, (p, q) in places.items() if n != line.leader}
         info["errors"].append(sum(distances.values()))
         info["distances"].append(distances)
+        info["route_errors"].append(sum(float(np.linalg.norm(p - q)) for n, (p, q) in self.places(
+            world, info["lanes"].headings[info["leg"]]).items() if n != line.leader))
         for name, robot in world.robots.items():
             info["tracks"][name].append([round(float(v), 3) for v in world.pose(robot)])
-        lead = world.pose(world.robots[line.leader])
         headings = [world.pose(world.robots[n])[2] for n in line.names if n != line.leader]
         info["turned_round_s"] += any(abs(wrap_angle(h - lead[2])) > TURNED_ROUND for h in headings)
         lateral = [float(np.dot(places[n][0] - lead[:2], normal(lead[2]))) for n in line.names]
@@ -352,11 +360,13 @@ class FormationMission(ScenarioMission):
             "mission_time_s": round(world.time, 3),
             "cum_fe": round(float(sum(errors)), 3),
             "normalised_error": round(float(sum(errors)) / t_max, 4),
+            "normalised_error_route": round(float(sum(info["route_errors"])) / t_max, 4),
             "max_fe": round(float(max(errors, default=0.0)), 3),
             "mean_distance_m": per_robot,
             "turned_round_s": int(info["turned_round_s"]),
             "order_broken_s": int(info["order_broken_s"]),
             "fe": [round(e, 3) for e in errors],
+            "fe_route": [round(e, 3) for e in info["route_errors"]],
         }
         return completed, metrics
 
