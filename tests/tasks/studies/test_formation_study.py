@@ -25,8 +25,8 @@ def test_a_reduction_within_half_to_twice_the_thesiss_figure_reproduces_it(measu
 
 
 def rows_of(errors: dict[str, list[float]], broken: dict[str, int]) -> list[dict]:
-    return [{"strategy": s, "seed": k, "completed": True, "normalised_error": e, "mission_time_s": 100.0 + k,
-             "route": "sharp", "order_broken_s": broken[s]} for s, values in errors.items()
+    return [{"strategy": s, "seed": k, "completed": True, "normalised_error": e, "normalised_error_route": e,
+             "mission_time_s": 100.0 + k, "route": "sharp", "order_broken_s": broken[s]} for s, values in errors.items()
             for k, e in enumerate(values)]
 
 
@@ -37,6 +37,7 @@ def test_changes_are_paired_by_seed_and_the_broken_line_is_judged_on_sharp_route
     assert measured == pytest.approx(-15.0) and pairs == 3 and p < 0.05
     found = {f.claim: f for f in claims(rows, ("I", "II", "III", "IV"))}
     assert found["II vs I: normalised error"].verdict == "yes"
+    assert found["II vs I: normalised error, route reading"].verdict == "yes"
     assert found["I fails on sharp turns: the line breaks"].verdict == "yes"
     assert found["IV vs III: mission time"].verdict == "yes"  # equal times: "little gain"
 
