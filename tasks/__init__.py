@@ -2,6 +2,7 @@
 studies that sweep them (``studies/``). ``MISSIONS`` names every mission ``teamsim run`` knows."""
 from __future__ import annotations
 
+from teamsim.tasks.missions.bounding_overwatch import BoundingOverwatchMission
 from teamsim.tasks.missions.box_pushing import BoxPushingMission
 from teamsim.tasks.missions.explore import ExploreMission
 from teamsim.tasks.missions.formation import FormationMission
@@ -12,4 +13,4 @@ from teamsim.tasks.missions.wander import WanderMission
 
 MISSIONS = {mission.name: mission for mission in (WanderMission(), NavigateMission(), HazardousWasteMission(),
                                                      BoxPushingMission(), ExploreMission(), JanitorialMission(),
-                                                     FormationMission())}
+                                                     BoundingOverwatchMission(), FormationMission())}

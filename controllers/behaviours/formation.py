@@ -53,11 +53,15 @@ class KeepFormationParams:
     settle: float = 0.1  # m: nearer its place than this, a follower turns to the line's heading
     back_within: float = 0.6  # m: a place behind and nearer than this is backed into (I, II)
     lookahead: float = 1.0  # m along the lane a lane keeper steers for (III, IV)
-    merge: float = 0.3  # m ... while it is ahead of its place
+    still: float = 0.1  # m/s: a place moving slower than this stands still (the tracker's noise is below it)
     track_alpha: float = 0.5  # alpha-beta tracker of a sensed teammate (position)
     track_beta: float = 0.2  # (velocity)
     heading_gain: float = 0.5  # share of a new sensed heading taken in
     next_leg: float = 1.0  # m: within this of its waypoint, the leader counts as turning onto the next leg (IV)
+    give_way: float = 0.5  # m: a crossing robot stops while its front IR sees something nearer than this
+    give_way_for: float = 15.0  # s: ... for at most this long
+    swerve_range: float = 0.6  # m: a follower steers away from IR readings nearer than this (neighbours: 0.7 m)
+    swerve_gain: float = 1.5  # push per reading at zero range, against a unit wish
     drive: DriveParams = field(default_factory=lambda: DriveParams(cruise=0.3, turn_rate=1.0, turn_gain=2.0,
                                                                    turn_in_place=0.8, avoid_range=0.25,
                                                                    slow_radius=0.01))
@@ -195,6 +199,19 @@ def place(strategy: str, line: Line, name: str, poses: dict[str, np.ndarray], ne
     return Goal(lead[:2] + offset * normal(heading), heading, line.leader, strategy == "III")
 
 
+def swerve(obs: Observation, params: KeepFormationParams) -> np.ndarray:
+    """A push away from what the IR sees within ``swerve_range``, in the body frame, to add to the unit vector of
+    the way a robot wants to go: ``swerve_gain`` x (1 - range / swerve_range) away from each such reading. It lets a
+    follower whose way is blocked by a robot standing still steer round it instead of backing off and meeting it
+    again (avoid-obstacles, underneath, still takes over nearer than its ``avoid_range``)."""
+    near = obs.ir_range < params.swerve_range
+    if not np.any(near):
+        return np.zeros(2)
+    weight = params.swerve_gain * (1.0 - obs.ir_range[near] / params.swerve_range)
+    bearings = np.asarray(obs.ir_bearings)[near]
+    return -np.array([np.sum(weight * np.cos(bearings)), np.sum(weight * np.sin(bearings))])
+
+
 class Track:
     """An alpha-beta tracker of a sensed teammate in the world frame: position, velocity and heading."""
 
@@ -263,6 +280,7 @@ class KeepFormation(FormationRobot):
                  rng: np.random.Generator, route: np.ndarray):
         super().__init__(robot, line, strategy, params, rng, route)
         self.news: tuple | None = None  # (where the leader was, the waypoint it announced there)
+        self.push = np.zeros(2)  # this tick's swerve, body frame
 
     def __call__(self, obs: Observation) -> Command:
         pose = self.estimate.update(obs)
@@ -273,6 +291,7 @@ class KeepFormation(FormationRobot):
         evade = self.avoid(obs)
         if evade is not None:
             return Command(*evade, behaviour="avoid-obstacles")
+        self.push = swerve(obs, self.params)
         self.follow_leg(poses)
         goal = place(self.strategy, self.line, self.name, poses, self.news, self.lanes, self.leg)
         if goal is None:
@@ -298,7 +317,7 @@ class KeepFormation(FormationRobot):
         error = goal.point - pose[:2]
         wanted = pace * np.array([math.cos(goal.heading), math.sin(goal.heading)]) + p.pull * error
         speed = min(float(np.linalg.norm(wanted)), p.catch_up)
-        if np.linalg.norm(error) < p.settle and pace < 0.05:
+        if np.linalg.norm(error) < p.settle and pace < p.still:
             return 0.0, self.turn_to(pose, goal.heading)
         bearing = wrap_angle(math.atan2(wanted[1], wanted[0]) - pose[2])
         if abs(bearing) > math.pi / 2 and np.linalg.norm(error) < p.back_within:
@@ -307,14 +326,14 @@ class KeepFormation(FormationRobot):
 
     def keep_lane(self, pose: np.ndarray, goal: Goal, pace: float) -> tuple[float, float]:
         """III and IV (§7.2: "aim toward the waypoint and moderate speed to stay aligned"): steer for a point on
-        the lane ahead of abreast of the robot (``lookahead``; ``merge`` while ahead of its place), at ``pace``
+        the lane ``lookahead`` ahead of abreast of the robot (abreast, while ahead of its place), at ``pace``
         plus a pull by the lag along the lane, never backwards while the place moves. A robot ahead of its place
         only closes on its lane, at a speed by its distance from it, then waits there facing the lane's way; once
         the place stands still (the line stopped short of it), it goes back to it as I and II do."""
         p = self.params
         way = np.array([math.cos(goal.heading), math.sin(goal.heading)])
         lag = goal.lag(pose[:2])
-        if pace < 0.05 and lag < -p.settle:  # the line has stopped short of it (the route's end): go back
+        if pace < p.still and lag < -p.settle:  # the line has stopped short of it (the route's end): go back
             return self.make_for(pose, goal, pace)
         aside = goal.aside(pose[:2])
         speed = float(np.clip(pace + p.pull * lag, 0.0, p.catch_up))
@@ -322,13 +341,16 @@ class KeepFormation(FormationRobot):
             speed = max(speed, min(p.pull * aside, p.catch_up))
         if speed < 0.02:
             return 0.0, self.turn_to(pose, goal.heading)
-        ahead = p.lookahead if lag > 0 else p.merge
+        ahead = p.lookahead if lag > 0 else 0.0  # ahead of its place: straight across to its lane, no further on
         aim = goal.point + (float(np.dot(pose[:2] - goal.point, way)) + ahead) * way
         return self.steer(speed, wrap_angle(math.atan2(aim[1] - pose[1], aim[0] - pose[0]) - pose[2]))
 
     def steer(self, speed: float, bearing: float) -> tuple[float, float]:
-        """(v, omega) for a bearing to steer by: on the spot beyond ``turn_in_place``."""
+        """(v, omega) for a bearing to steer by, bent away from what the IR sees near (:func:`swerve`): on the spot
+        beyond ``turn_in_place``."""
         drive = self.params.drive
+        way = np.array([math.cos(bearing), math.sin(bearing)]) + self.push
+        bearing = math.atan2(way[1], way[0])
         omega = float(np.clip(drive.turn_gain * bearing, -drive.turn_rate, drive.turn_rate))
         return (0.0 if abs(bearing) > drive.turn_in_place else speed * math.cos(bearing)), omega
 
@@ -340,14 +362,13 @@ class KeepFormation(FormationRobot):
 class RouteLeader(FormationRobot):
     """The group leader: follow-route through the waypoints, announcing each new one (strategy III's news), at
     ``cruise`` scaled down while a neighbour is far from its place; it holds at the last waypoint, facing the last
-    leg's way. With no line (``line`` of itself alone) it is a plain route follower that sets off at ``start_at``:
-    the crossing team's robots."""
+    leg's way. With no line (``line`` of itself alone) it is a plain route follower (:class:`Crossing` drives
+    one)."""
 
     def __init__(self, robot: RobotModel, line: Line, strategy: str, params: KeepFormationParams,
-                 rng: np.random.Generator, route: np.ndarray, announce: bool = True, start_at: float = 0.0):
+                 rng: np.random.Generator, route: np.ndarray, announce: bool = True):
         super().__init__(robot, line, strategy, params, rng, route)
         self.route = np.asarray(route, float)
-        self.start_at = start_at
         self.target = 1
         self.announce = announce
         self.finished_at: float | None = None
@@ -368,8 +389,6 @@ class RouteLeader(FormationRobot):
     def __call__(self, obs: Observation) -> Command:
         pose = self.estimate.update(obs)
         broadcast = {"waypoint": [float(v) for v in self.route[self.target]]} if self.announce else None
-        if obs.time < self.start_at:
-            return Command(behaviour="wait", broadcast=broadcast)
         if pose is None:
             return Command(behaviour="follow-route", broadcast=broadcast)
         poses = self.sense(obs, pose)
@@ -395,3 +414,23 @@ class RouteLeader(FormationRobot):
             turn = turn_to(pose, math.atan2(way[1], way[0]), self.params.drive, tolerance=0.02)
             return Command(0.0, turn or 0.0, behaviour="hold", broadcast=broadcast)
         return Command(*command, behaviour="follow-route", broadcast=broadcast)
+
+
+class Crossing:
+    """A robot of the second team that crosses the line's route: it sets off at ``start_at`` and drives its own
+    route (``driver``, a route leader with no line), giving way: while its front IR sees something nearer than
+    ``give_way`` it stops, for at most ``give_way_for`` s, before going on under avoid-obstacles. (Two robots
+    avoiding each other with the same manoeuvre can meet again and again; one that waits breaks the tie.)"""
+
+    def __init__(self, driver: RouteLeader, robot: RobotModel, start_at: float):
+        self.driver, self.start_at, self.params = driver, start_at, driver.params
+        self.front = np.abs(np.asarray(robot.ir_bearings)) < math.radians(60)
+        self.blocked_since: float | None = None
+
+    def __call__(self, obs: Observation) -> Command:
+        blocked = bool(np.any(obs.ir_range[self.front] < self.params.give_way))
+        self.blocked_since = (self.blocked_since if self.blocked_since is not None else obs.time) if blocked else None
+        if obs.time < self.start_at or (blocked and obs.time - self.blocked_since < self.params.give_way_for):
+            self.driver.estimate.update(obs)  # it keeps its pose estimate while it waits
+            return Command(behaviour="wait" if obs.time < self.start_at else "give-way")
+        return self.driver(obs)

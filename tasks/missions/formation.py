@@ -27,8 +27,8 @@ import cv2
 import numpy as np
 
 from teamsim.config import ConfigError, RadioConfig, setting
-from teamsim.controllers.behaviours.formation import (SIGNAL, STRATEGIES, KeepFormation, KeepFormationParams, Lanes,
-                                                      Line, RouteLeader, normal)
+from teamsim.controllers.behaviours.formation import (SIGNAL, STRATEGIES, Crossing, KeepFormation,
+                                                      KeepFormationParams, Lanes, Line, RouteLeader, normal)
 from teamsim.models.robot import RobotModel
 from teamsim.positioning import wrap_angle
 from teamsim.scenario import Arena, BoxObstacle, RobotEntry, Scenario, Spot, scene_of
@@ -268,8 +268,8 @@ class FormationMission(ScenarioMission):
         if robot.name not in line.names:
             alone = Line((robot.name,), robot.name, task.spacing)
             route = np.array([(p.x, p.y) for p in settings.route])
-            brain = RouteLeader(robot, alone, "II", settings.behaviour, rng, route, announce=False,
-                                start_at=settings.start_at)
+            brain = Crossing(RouteLeader(robot, alone, "II", settings.behaviour, rng, route, announce=False), robot,
+                             settings.start_at)
         elif robot.name == line.leader:
             brain = RouteLeader(robot, line, task.strategy, settings.behaviour, rng, info["route"])
         else:

@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 
 from teamsim.controllers.base import Observation
-from teamsim.controllers.behaviours.formation import (SIGNAL, Goal, KeepFormation, KeepFormationParams, Lanes, Line,
-                                                      RouteLeader, Track, place)
+from teamsim.controllers.behaviours.formation import (SIGNAL, Crossing, Goal, KeepFormation, KeepFormationParams,
+                                                      Lanes, Line, RouteLeader, Track, place, swerve)
 from teamsim.models import build_robot
 from teamsim.positioning import PoseFix
 
@@ -107,10 +107,37 @@ def test_the_tracker_learns_a_teammates_velocity_from_noisy_positions():
     assert track.pose(36.0)[:2] == pytest.approx([0.3 * 36.0, 1.0], abs=0.15)
 
 
-def observation(time: float, pose, sensed: dict) -> Observation:
-    return Observation(time=time, robot="B", ir_raw=np.zeros(10), ir_range=np.full(10, np.inf),
-                       ir_bearings=np.zeros(10), pose=PoseFix(*pose, time), motor_speeds=np.zeros(2),
+BEARINGS = np.linspace(-math.pi, math.pi, 10, endpoint=False)
+
+
+def observation(time: float, pose, sensed: dict, ranges=None) -> Observation:
+    return Observation(time=time, robot="B", ir_raw=np.zeros(10),
+                       ir_range=np.full(10, np.inf) if ranges is None else np.asarray(ranges, float),
+                       ir_bearings=BEARINGS, pose=PoseFix(*pose, time), motor_speeds=np.zeros(2),
                        signals={SIGNAL: sensed})
+
+
+def test_swerve_pushes_away_from_near_readings_only():
+    params = KeepFormationParams()
+    ranges = np.full(10, np.inf)
+    assert swerve(observation(0.0, (0, 0, 0), {}, ranges), params) == pytest.approx([0.0, 0.0])
+    ranges[5] = 0.3  # dead ahead (bearing 0), half the swerve range away
+    assert swerve(observation(0.0, (0, 0, 0), {}, ranges), params) == pytest.approx([-0.75, 0.0])
+    ranges[5] = 0.7  # a neighbour in the line, 0.7 m off: no push
+    assert swerve(observation(0.0, (0, 0, 0), {}, ranges), params) == pytest.approx([0.0, 0.0])
+
+
+def test_a_crossing_robot_waits_for_its_time_then_gives_way_to_what_is_ahead_for_a_while():
+    robot = build_robot("diffdrive", "X1")
+    driver = RouteLeader(robot, Line(("X1",), "X1", 1.2), "II", KeepFormationParams(), np.random.default_rng(0),
+                         np.array([(0.0, 0.0), (10.0, 0.0)]), announce=False)
+    crossing = Crossing(driver, robot, start_at=5.0)
+    ahead = np.full(10, np.inf)
+    ahead[robot.ir_bearings.tolist().index(min(robot.ir_bearings, key=abs))] = 0.3
+    assert crossing(observation(0.0, (0.0, 0.0, 0.0), {})).behaviour == "wait"
+    assert crossing(observation(6.0, (0.0, 0.0, 0.0), {})).behaviour == "follow-route"
+    assert crossing(observation(7.0, (0.0, 0.0, 0.0), {}, ahead)).behaviour == "give-way"
+    assert crossing(observation(7.0 + 16.0, (0.0, 0.0, 0.0), {}, ahead)).behaviour != "give-way"  # 15 s at most
 
 
 @pytest.mark.parametrize("c_at, share", [((0.0, -1.2), 1.0), ((-2.0, -1.2), 0.0)])
