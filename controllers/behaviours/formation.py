@@ -244,8 +244,9 @@ class Track:
 
 
 class FormationRobot:
-    """What every robot of the line shares: its own pose estimate, avoid-obstacles, and the tracks of the
-    teammates it senses (from ``Observation.signals[SIGNAL]``, relative to itself)."""
+    """What every robot of the line shares: its own pose estimate, avoid-obstacles, the tracks of the teammates it
+    senses (from ``Observation.signals[SIGNAL]``, relative to itself), and steering that swerves round near
+    things."""
 
     def __init__(self, robot: RobotModel, line: Line, strategy: str, params: KeepFormationParams,
                  rng: np.random.Generator, route: np.ndarray):
@@ -255,6 +256,7 @@ class FormationRobot:
         self.tracks: dict[str, Track] = {}
         self.lanes = Lanes(route) if strategy == "IV" else None
         self.leg = 0
+        self.push = np.zeros(2)  # this tick's swerve, body frame
 
     def sense(self, obs: Observation, pose: np.ndarray) -> dict[str, np.ndarray]:
         """Fold this tick's fresh readings into the tracks; the teammates' poses now."""
@@ -265,6 +267,19 @@ class FormationRobot:
                 track.update(pose[:2] + np.array([c * dx - s * dy, s * dx + c * dy]),
                              wrap_angle(pose[2] + dheading), when)
         return {name: t.pose(obs.time) for name, t in self.tracks.items() if t.position is not None}
+
+    def steer(self, speed: float, bearing: float, drive: DriveParams | None = None) -> tuple[float, float]:
+        """(v, omega) for a bearing to steer by, bent away from what the IR sees near (:func:`swerve`): on the spot
+        beyond ``turn_in_place``."""
+        drive = drive or self.params.drive
+        way = np.array([math.cos(bearing), math.sin(bearing)]) + self.push
+        bearing = math.atan2(way[1], way[0])
+        omega = float(np.clip(drive.turn_gain * bearing, -drive.turn_rate, drive.turn_rate))
+        return (0.0 if abs(bearing) > drive.turn_in_place else speed * math.cos(bearing)), omega
+
+    def turn_to(self, pose: np.ndarray, heading: float) -> float:
+        drive = self.params.drive
+        return float(np.clip(drive.turn_gain * wrap_angle(heading - pose[2]), -drive.turn_rate, drive.turn_rate))
 
     def follow_leg(self, poses: dict[str, np.ndarray]) -> None:
         if self.lanes is not None and self.line.leader in poses:
@@ -280,7 +295,6 @@ class KeepFormation(FormationRobot):
                  rng: np.random.Generator, route: np.ndarray):
         super().__init__(robot, line, strategy, params, rng, route)
         self.news: tuple | None = None  # (where the leader was, the waypoint it announced there)
-        self.push = np.zeros(2)  # this tick's swerve, body frame
 
     def __call__(self, obs: Observation) -> Command:
         pose = self.estimate.update(obs)
@@ -345,20 +359,6 @@ class KeepFormation(FormationRobot):
         aim = goal.point + (float(np.dot(pose[:2] - goal.point, way)) + ahead) * way
         return self.steer(speed, wrap_angle(math.atan2(aim[1] - pose[1], aim[0] - pose[0]) - pose[2]))
 
-    def steer(self, speed: float, bearing: float) -> tuple[float, float]:
-        """(v, omega) for a bearing to steer by, bent away from what the IR sees near (:func:`swerve`): on the spot
-        beyond ``turn_in_place``."""
-        drive = self.params.drive
-        way = np.array([math.cos(bearing), math.sin(bearing)]) + self.push
-        bearing = math.atan2(way[1], way[0])
-        omega = float(np.clip(drive.turn_gain * bearing, -drive.turn_rate, drive.turn_rate))
-        return (0.0 if abs(bearing) > drive.turn_in_place else speed * math.cos(bearing)), omega
-
-    def turn_to(self, pose: np.ndarray, heading: float) -> float:
-        drive = self.params.drive
-        return float(np.clip(drive.turn_gain * wrap_angle(heading - pose[2]), -drive.turn_rate, drive.turn_rate))
-
-
 class RouteLeader(FormationRobot):
     """The group leader: follow-route through the waypoints, announcing each new one (strategy III's news), at
     ``cruise`` scaled down while a neighbour is far from its place; it holds at the last waypoint, facing the last
@@ -395,6 +395,7 @@ class RouteLeader(FormationRobot):
         evade = self.avoid(obs)
         if evade is not None:
             return Command(*evade, behaviour="avoid-obstacles", broadcast=broadcast)
+        self.push = swerve(obs, self.params)
         self.follow_leg({**poses, self.name: pose})
         share = self.pace(poses, pose)
         last = self.target == len(self.route) - 1
@@ -413,6 +414,10 @@ class RouteLeader(FormationRobot):
             way = self.route[-1] - self.route[-2]
             turn = turn_to(pose, math.atan2(way[1], way[0]), self.params.drive, tolerance=0.02)
             return Command(0.0, turn or 0.0, behaviour="hold", broadcast=broadcast)
+        if np.any(self.push):  # something near: the same way bent round it (steer_to's law otherwise)
+            way = self.route[self.target] - pose[:2]
+            speed = drive.cruise * min(1.0, float(np.linalg.norm(way)) / drive.slow_radius)
+            command = self.steer(speed, wrap_angle(math.atan2(way[1], way[0]) - pose[2]), drive)
         return Command(*command, behaviour="follow-route", broadcast=broadcast)
 
 

@@ -190,11 +190,12 @@ def janitorial(seconds: float = 300.0, seed: int = 0, repeats: int = 2) -> dict:
 
 
 def formation(seconds: float = 120.0, seed: int = 0, repeats: int = 2) -> dict:
-    """Keeping formation: four robots in line under strategy IV, and a crossing team of two."""
+    """Keeping formation: four robots in line under strategy IV, and a crossing team of two (held to issue 27's
+    figure for eight robots, >= 15x real time)."""
     config = TrialConfig(mission="formation", params=MISSIONS["formation"].Params(crossing=2), seed=seed)
     print(f"bench formation: A-D in line (strategy IV) and X1, X2 crossing, seed {seed}, {seconds:g} s simulated, "
           f"full control stack, no video, best of {repeats}")
-    return mission_speed(config, seconds, repeats)
+    return mission_speed(config, seconds, repeats, target=15.0)
 
 
 def overwatch(seconds: float = 120.0, seed: int = 0, repeats: int = 2) -> dict:
