@@ -6,17 +6,25 @@ import math
 from pathlib import Path
 
 import cv2
-import matplotlib
 import numpy as np
 
 from teamsim.files import write_atomic
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402  (after the backend is chosen)
-
 PANEL = 480  # px, the side panel's height and width
 PANEL_SPAN = 12.0  # m of floor across the panel, centred on the leader
 ROUTE_BGR, GREY, BLACK = (30, 180, 230), (150, 150, 150), (0, 0, 0)
+TAB10 = ((0.12, 0.47, 0.71), (1.0, 0.5, 0.05), (0.17, 0.63, 0.17), (0.84, 0.15, 0.16), (0.58, 0.4, 0.74),
+         (0.55, 0.34, 0.29), (0.89, 0.47, 0.76), (0.5, 0.5, 0.5), (0.74, 0.74, 0.13), (0.09, 0.75, 0.81))
+
+
+def pyplot():
+    """matplotlib's pyplot on the Agg backend, imported when a figure is drawn (it costs half a second)."""
+    import matplotlib  # noqa: PLC0415
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt  # noqa: PLC0415
+
+    return plt
 
 
 def _box_corners(box) -> np.ndarray:
@@ -27,7 +35,7 @@ def _box_corners(box) -> np.ndarray:
 
 def colours(names) -> dict[str, tuple[float, float, float]]:
     """A distinct colour (RGB in [0, 1]) per robot, in order."""
-    return {n: matplotlib.colormaps["tab10"](k % 10)[:3] for k, n in enumerate(names)}
+    return {n: TAB10[k % len(TAB10)] for k, n in enumerate(names)}
 
 
 def panel_image(scenario, info: dict, places: dict, time: float) -> np.ndarray:
@@ -65,6 +73,7 @@ def panel_image(scenario, info: dict, places: dict, time: float) -> np.ndarray:
 
 def write_formation(path: Path, scenario, info: dict) -> None:
     """``formation.png``: the paths from above (route dashed, obstacles grey) and fe_t per second."""
+    plt = pyplot()
     fig, (top, curve) = plt.subplots(1, 2, figsize=(11, 4.5), gridspec_kw={"width_ratios": [1, 1.3]})
     for box in scenario.arena.boxes:
         top.add_patch(plt.Polygon(_box_corners(box), color="0.6"))
@@ -91,5 +100,5 @@ def write_figure(path: Path, fig) -> None:
 
     buffer = BytesIO()
     fig.savefig(buffer, format="png", dpi=110)
-    plt.close(fig)
+    pyplot().close(fig)
     write_atomic(path, buffer.getvalue())

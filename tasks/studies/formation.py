@@ -19,7 +19,7 @@ from teamsim.controllers.behaviours.formation import STRATEGIES
 from teamsim.files import write_atomic, write_csv
 from teamsim.sweep import run_trials
 from teamsim.tasks.missions.formation import FormationMission, FormationParams
-from teamsim.tasks.missions.formation_figures import plt, write_figure
+from teamsim.tasks.missions.formation_figures import pyplot, write_figure
 from teamsim.tasks.studies.findings import Finding, paired, paired_p, table
 
 COLUMNS = ("strategy", "run", "seed", "route", "crossing", "status", "completed", "mission_time_s",
@@ -202,7 +202,7 @@ DIFFERENCES = """\
 # -- figures --------------------------------------------------------------------------------------------------------
 def plot_time_error(path: Path, rows: list[dict], strategies: tuple[str, ...]) -> None:
     """Fig. 7-2's form: each completed run at (mission time, normalised error), per strategy, with its mean."""
-    fig, axes = plt.subplots(figsize=(7, 5))
+    fig, axes = pyplot().subplots(figsize=(7, 5))
     for s in strategies:
         done = [r for r in rows if r["strategy"] == s and r["completed"]]
         if not done:
@@ -223,7 +223,7 @@ def plot_time_error(path: Path, rows: list[dict], strategies: tuple[str, ...]) -
 
 def plot_error_over_time(path: Path, configs: list[TrialConfig], summaries: list[dict]) -> None:
     """fe_t over time under each strategy, in the study's first run (sharp corners, no crossing team)."""
-    fig, axes = plt.subplots(figsize=(9, 4))
+    fig, axes = pyplot().subplots(figsize=(9, 4))
     for config, summary in zip(configs, summaries):
         series = (summary.get("metrics") or {}).get("fe")
         if config.run_id.endswith("-0") and series:
