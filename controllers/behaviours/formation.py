@@ -19,7 +19,9 @@ Every follower drives at its place with the tracked reference's speed fed forwar
 (the "moderate speed to stay aligned" of §7.2, used by all four). Teammates are sensed locally (the mission's
 ``formation`` signal: relative poses with the positioning model's noise) and tracked with an alpha-beta filter in
 the world frame of the robot's own pose estimate. The leader slows while a neighbour it senses is far from its
-place by the strategy in use. The thesis gives no control laws: docs/decisions.md, "Keeping formation".
+place by the strategy in use. Every robot bends its way round near IR readings (:func:`swerve`), and the robots of
+a crossing team give way (:class:`Crossing`). The thesis gives no control laws: docs/decisions.md, "Keeping
+formation".
 """
 from __future__ import annotations
 
