@@ -279,9 +279,9 @@ class FormationRobot:
         omega = float(np.clip(drive.turn_gain * bearing, -drive.turn_rate, drive.turn_rate))
         return (0.0 if abs(bearing) > drive.turn_in_place else speed * math.cos(bearing)), omega
 
-    def turn_to(self, pose: np.ndarray, heading: float) -> float:
-        drive = self.params.drive
-        return float(np.clip(drive.turn_gain * wrap_angle(heading - pose[2]), -drive.turn_rate, drive.turn_rate))
+    def face(self, pose: np.ndarray, heading: float) -> float:
+        """Turn rate towards ``heading`` (goto's turn_to, with no dead band)."""
+        return turn_to(pose, heading, self.params.drive, tolerance=0.0) or 0.0
 
     def follow_leg(self, poses: dict[str, np.ndarray]) -> None:
         if self.lanes is not None and self.line.leader in poses:
@@ -334,10 +334,10 @@ class KeepFormation(FormationRobot):
         wanted = pace * np.array([math.cos(goal.heading), math.sin(goal.heading)]) + p.pull * error
         speed = min(float(np.linalg.norm(wanted)), p.catch_up)
         if np.linalg.norm(error) < p.settle and pace < p.still:
-            return 0.0, self.turn_to(pose, goal.heading)
+            return 0.0, self.face(pose, goal.heading)
         bearing = wrap_angle(math.atan2(wanted[1], wanted[0]) - pose[2])
         if abs(bearing) > math.pi / 2 and np.linalg.norm(error) < p.back_within:
-            return speed * math.cos(bearing), self.turn_to(pose, goal.heading)
+            return speed * math.cos(bearing), self.face(pose, goal.heading)
         return self.steer(speed, bearing)
 
     def keep_lane(self, pose: np.ndarray, goal: Goal, pace: float) -> tuple[float, float]:
@@ -356,7 +356,7 @@ class KeepFormation(FormationRobot):
         if aside > p.settle:
             speed = max(speed, min(p.pull * aside, p.catch_up))
         if speed < 0.02:
-            return 0.0, self.turn_to(pose, goal.heading)
+            return 0.0, self.face(pose, goal.heading)
         ahead = p.lookahead if lag > 0 else 0.0  # ahead of its place: straight across to its lane, no further on
         aim = goal.point + (float(np.dot(pose[:2] - goal.point, way)) + ahead) * way
         return self.steer(speed, wrap_angle(math.atan2(aim[1] - pose[1], aim[0] - pose[0]) - pose[2]))
