@@ -66,12 +66,36 @@ class PositioningConfig:
 class VideoConfig:
     enabled: bool = setting(False, meaning="render video.mp4 while running")
     fps: int = setting(30, lo=1, hi=120, meaning="video frame rate (also the trajectory sampling rate)")
-    width: int = setting(640, lo=64, hi=3840, meaning="frame width, px")
-    height: int = setting(480, lo=48, hi=2160, meaning="frame height, px")
-    camera: str = setting("top", meaning="camera: 'top' or ROBOT/track")
+    width: int = setting(640, lo=64, hi=3840, meaning="frame width, px (even: H.264 in yuv420p)")
+    height: int = setting(480, lo=48, hi=2160, meaning="frame height, px (even: H.264 in yuv420p)")
+    camera: str = setting("top", meaning="camera: 'top', 'perspective' (the whole arena, oblique) or ROBOT "
+                                         "(its tracking camera, also ROBOT/track)")
     speedup: float | None = setting(None, lo=1.0, hi=1000.0,
                                     meaning="simulated seconds per second of video, a time-lapse (unset: the "
                                             "mission's default, 1 for most)")
+
+    def check(self) -> None:
+        for name in ("width", "height"):
+            if getattr(self, name) % 2:
+                raise ConfigError(f"video.{name}={getattr(self, name)}: must be even (H.264 in yuv420p)")
+
+    @staticmethod
+    def parse_size(text: str) -> tuple[int, int]:
+        """``WIDTHxHEIGHT`` (``1280x720``) as (width, height), within the width and height bounds and even;
+        else ConfigError, one line, naming ``--video-size`` and what it allows."""
+        bounds = {f.name: (f.metadata["lo"], f.metadata["hi"]) for f in dataclasses.fields(VideoConfig)
+                  if f.name in ("width", "height")}
+        (w_lo, w_hi), (h_lo, h_hi) = bounds["width"], bounds["height"]
+        allowed = f"allowed: WIDTHxHEIGHT, even whole pixels, width {w_lo}-{w_hi}, height {h_lo}-{h_hi} (e.g. 1280x720)"
+        width, x, height = text.strip().lower().partition("x")
+        if not (x and all(side.isascii() and side.isdigit() for side in (width, height))):
+            raise ConfigError(f"--video-size: {text!r} is not WIDTHxHEIGHT; {allowed}")
+        size = int(width), int(height)
+        if not (w_lo <= size[0] <= w_hi and h_lo <= size[1] <= h_hi):
+            raise ConfigError(f"--video-size: {text} is out of range; {allowed}")
+        if size[0] % 2 or size[1] % 2:
+            raise ConfigError(f"--video-size: {text} has an odd side (H.264 in yuv420p needs even ones); {allowed}")
+        return size
 
 
 @dataclass

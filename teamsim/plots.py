@@ -1,98 +1,83 @@
-"""Plots for reports, drawn with OpenCV (no plotting library to install): grouped bar charts and line charts."""
+"""Figures for reports and runs, drawn with matplotlib and written as PNG and SVG side by side (the same stem):
+``pyplot()`` and ``save_figure`` for any figure, ``grouped_bars`` and ``line_chart`` for the common ones.
+
+matplotlib is imported only when a figure is drawn (it costs half a second), never with ``teamsim.tasks`` or the CLI.
+"""
 from __future__ import annotations
 
+from io import BytesIO
 from pathlib import Path
 
-import cv2
 import numpy as np
 
 from teamsim.files import write_atomic
 
-_FONT = cv2.FONT_HERSHEY_SIMPLEX
-_COLOURS = [(180, 119, 31), (14, 127, 255), (44, 160, 44), (40, 39, 214), (189, 103, 148), (75, 86, 140),
-            (194, 119, 227), (127, 127, 127)]
+DPI = 110
+
+
+def pyplot():
+    """matplotlib's pyplot on the Agg backend (headless), imported on first use."""
+    import matplotlib  # noqa: PLC0415
+
+    matplotlib.use("Agg")
+    matplotlib.rcParams["svg.hashsalt"] = "teamsim"  # the same SVG for the same figure
+    import matplotlib.pyplot as plt  # noqa: PLC0415
+
+    return plt
+
+
+def save_figure(fig, path: Path) -> None:
+    """``fig`` as ``path`` (PNG) and ``path`` with suffix ``.svg``, each written atomically; the figure is closed."""
+    path = Path(path)
+    try:
+        for suffix, options in ((".png", {}), (".svg", {"metadata": {"Date": None}})):
+            buffer = BytesIO()
+            fig.savefig(buffer, format=suffix[1:], dpi=DPI, **options)
+            write_atomic(path.with_suffix(suffix), buffer.getvalue())
+    finally:
+        pyplot().close(fig)
 
 
 def grouped_bars(path: Path, title: str, groups: list[str], series: dict[str, list[float]], y_label: str,
-                 y_max: float | None = None, width: int = 1100, height: int = 420) -> None:
-    """One cluster of bars per group, one bar per series (NaN bars are left out), with a legend."""
-    image, y_of = _canvas(title, y_label, _top(series, y_max), width, height)
-    plot_w = width - LEFT - RIGHT
-    cluster = plot_w / max(len(groups), 1)
-    bar = cluster * 0.8 / max(len(series), 1)
-    for g, group in enumerate(groups):
-        x0 = LEFT + g * cluster + cluster * 0.1
-        for s, vs in enumerate(series.values()):
-            value = vs[g]
-            if np.isfinite(value):
-                x = int(x0 + s * bar)
-                cv2.rectangle(image, (x, y_of(value)), (int(x + bar) - 1, y_of(0)), _COLOURS[s % len(_COLOURS)], -1)
-        cv2.putText(image, group, (int(x0), height - BOTTOM + 18), _FONT, 0.4, (0, 0, 0), 1, cv2.LINE_AA)
-    cv2.line(image, (LEFT, y_of(0)), (width - RIGHT, y_of(0)), (0, 0, 0), 1)
-    _legend(image, series)
-    _write(path, image)
+                 y_max: float | None = None) -> None:
+    """One cluster of bars per group, one bar per series (NaN bars are left out), with a legend below."""
+    fig, axes = pyplot().subplots(figsize=(10, 3.8))
+    bar = 0.8 / max(len(series), 1)
+    x = np.arange(len(groups))
+    for s, (name, values) in enumerate(series.items()):
+        values = np.asarray(values, float)
+        shown = np.isfinite(values)
+        axes.bar(x[shown] - 0.4 + bar * (s + 0.5), values[shown], bar, label=name, color=f"C{s % 10}")
+    axes.set_xticks(x, groups)
+    axes.set_xlim(-0.5, len(groups) - 0.5)
+    _finish(fig, axes, title, y_label, y_max, len(series))
+    save_figure(fig, path)
 
 
 def line_chart(path: Path, title: str, x: list[float], series: dict[str, list[float]], x_label: str, y_label: str,
-               y_max: float | None = None, marks: list[tuple[float, str]] = (), width: int = 1100,
-               height: int = 420) -> None:
+               y_max: float | None = None, marks: list[tuple[float, str]] = ()) -> None:
     """One line per series over ``x``; ``marks`` are (x, label) events drawn as labelled vertical lines."""
-    image, y_of = _canvas(title, y_label, _top(series, y_max), width, height)
-    x_max = max([*x, *(t for t, _ in marks), 1e-9])
-
-    def x_of(value: float) -> int:
-        return int(LEFT + (width - LEFT - RIGHT) * value / x_max)
-
+    fig, axes = pyplot().subplots(figsize=(10, 3.8))
     for k, (t, label) in enumerate(marks):
-        cv2.line(image, (x_of(t), TOP), (x_of(t), y_of(0)), (160, 160, 160), 1)
-        cv2.putText(image, label, (x_of(t) + 3, TOP + 12 + 14 * (k % 6)), _FONT, 0.35, (90, 90, 90), 1, cv2.LINE_AA)
-    for s, values in enumerate(series.values()):
-        points = np.array([(x_of(a), y_of(b)) for a, b in zip(x, values)], np.int32)
-        if len(points) > 1:
-            cv2.polylines(image, [points], False, _COLOURS[s % len(_COLOURS)], 2, cv2.LINE_AA)
-    cv2.line(image, (LEFT, y_of(0)), (width - RIGHT, y_of(0)), (0, 0, 0), 1)
-    for k in range(6):
-        value = x_max * k / 5
-        cv2.putText(image, f"{value:.4g}", (x_of(value) - 10, y_of(0) + 16), _FONT, 0.4, (0, 0, 0), 1, cv2.LINE_AA)
-    cv2.putText(image, x_label, (width // 2, y_of(0) + 34), _FONT, 0.45, (0, 0, 0), 1, cv2.LINE_AA)
-    _legend(image, series)
-    _write(path, image)
+        axes.axvline(t, color="0.63", lw=1)
+        axes.annotate(label, (t, 1), xycoords=("data", "axes fraction"), xytext=(3, -10 - 11 * (k % 6)),
+                      textcoords="offset points", fontsize=7, color="0.35")
+    for s, (name, values) in enumerate(series.items()):
+        axes.plot(x, values, color=f"C{s % 10}", lw=2, label=name)
+    axes.set_xlim(0, max([*x, *(t for t, _ in marks), 1e-9]))
+    axes.set_xlabel(x_label)
+    _finish(fig, axes, title, y_label, y_max, len(series))
+    save_figure(fig, path)
 
 
-LEFT, RIGHT, TOP, BOTTOM = 70, 20, 40, 70
-
-
-def _top(series: dict[str, list[float]], y_max: float | None) -> float:
-    values = np.array([v for vs in series.values() for v in vs], float)
-    return y_max or (float(np.nanmax(values)) * 1.1 if np.isfinite(values).any() else 1.0)
-
-
-def _canvas(title: str, y_label: str, y_max: float, width: int, height: int):
-    """A white image with the title and the y axis's grid; and the y-to-pixel map."""
-    image = np.full((height, width, 3), 255, np.uint8)
-    plot_h = height - TOP - BOTTOM
-
-    def y_of(value: float) -> int:
-        return int(TOP + plot_h * (1 - min(value, y_max) / y_max))
-
-    cv2.putText(image, title, (LEFT, 26), _FONT, 0.6, (0, 0, 0), 1, cv2.LINE_AA)
-    for k in range(6):
-        value = y_max * k / 5
-        cv2.line(image, (LEFT, y_of(value)), (width - RIGHT, y_of(value)), (225, 225, 225), 1)
-        cv2.putText(image, f"{value:.3g}", (8, y_of(value) + 4), _FONT, 0.4, (0, 0, 0), 1, cv2.LINE_AA)
-    cv2.putText(image, y_label, (8, TOP - 8), _FONT, 0.4, (0, 0, 0), 1, cv2.LINE_AA)
-    return image, y_of
-
-
-def _legend(image: np.ndarray, series: dict) -> None:
-    height = image.shape[0]
-    for s, name in enumerate(series):
-        x = LEFT + s * 130
-        cv2.rectangle(image, (x, height - 28), (x + 14, height - 16), _COLOURS[s % len(_COLOURS)], -1)
-        cv2.putText(image, name, (x + 20, height - 17), _FONT, 0.45, (0, 0, 0), 1, cv2.LINE_AA)
-
-
-def _write(path: Path, image: np.ndarray) -> None:
-    ok, png = cv2.imencode(".png", image)
-    if ok:
-        write_atomic(Path(path), png.tobytes())
+def _finish(fig, axes, title: str, y_label: str, y_max: float | None, entries: int) -> None:
+    """Title, the y axis from 0 (to ``y_max`` if given) with a light grid, the legend in a row below."""
+    axes.set_title(title, loc="left")
+    axes.set_ylabel(y_label)
+    axes.set_ylim(0, y_max)
+    axes.grid(axis="y", color="0.88")
+    axes.set_axisbelow(True)
+    axes.spines[["top", "right"]].set_visible(False)
+    if entries:
+        axes.legend(loc="upper left", bbox_to_anchor=(0, -0.12), ncol=min(entries, 8), frameon=False)
+    fig.tight_layout()

@@ -25,11 +25,12 @@ import mujoco
 import numpy as np
 
 import teamsim
-from teamsim.config import ConfigError, TrialConfig, validate
+from teamsim.config import ConfigError, TrialConfig, VideoConfig, apply_setting, validate
+from teamsim.faults import parse_fault
 from teamsim.files import write_json
 from teamsim.progress import Progress
 from teamsim.recording import EventLog, MotivationRecorder, TrajectoryRecorder
-from teamsim.scenario import resolve, scenario_of, to_data
+from teamsim.scenario import configure, resolve, scenario_of, supports, to_data
 from teamsim.tasks import MISSIONS
 from teamsim.timeline import write_timeline
 from teamsim.world import PhysicsUnstable, World
@@ -50,6 +51,24 @@ def mission_of(name: str):
     if name not in MISSIONS:
         raise ConfigError(f"unknown mission {name!r}; known: {', '.join(MISSIONS)}")
     return MISSIONS[name]
+
+
+def trial_config(mission_name: str, *, scenario: Path | str | None = None, seed: int | None = None,
+                 duration: float | None = None, settings: tuple | list = (), faults: tuple | list = (),
+                 out: str = "renders", run_id: str | None = None, video: VideoConfig | None = None) -> TrialConfig:
+    """A trial's configuration as ``teamsim run`` builds it from its arguments: ``settings`` are ``--set KEY=VALUE``
+    strings and ``faults`` are ``--fault`` specs (precedence: teamsim/cli/scenario.py). Bad input raises
+    ConfigError naming the field."""
+    mission = mission_of(mission_name)
+    config = TrialConfig(mission=mission_name, params=mission.Params(), seed=seed or 0, duration=duration,
+                         out=str(out), run_id=run_id, video=video or VideoConfig())
+    if scenario or supports(mission):
+        return configure(mission, config, scenario, seed, duration, list(settings), list(faults))
+    for assignment in settings:
+        apply_setting(config, assignment)
+    config.faults = [parse_fault(spec) for spec in faults]
+    validate(config)
+    return config
 
 
 def make_run_dir(config: TrialConfig) -> Path:

@@ -31,8 +31,8 @@ from typing import Any
 import numpy as np
 import yaml
 
-from teamsim.config import (ConfigError, PositioningConfig, RadioConfig, Timing, TrialConfig, check_value,
-                            setting)
+from teamsim.config import (ConfigError, PositioningConfig, RadioConfig, Timing, TrialConfig, apply_setting,
+                            check_value, setting, settable_keys, validate)
 from teamsim.faults import FAULT_KINDS, Fault, parse_fault
 from teamsim.models import ROBOT_BUILDERS, ROBOT_KINDS, build_robot
 from teamsim.models.arenas import OBSTACLE_RGBA, Bog, Box, add_bog, walled_room
@@ -691,6 +691,43 @@ def config_of(scenario: Scenario, mission, like: TrialConfig, extra_faults: list
     return dataclasses.replace(like, mission=mission.name, seed=scenario.seed, duration=scenario.duration,
                                timing=scenario.timing, radio=scenario.radio, positioning=scenario.positioning,
                                faults=faults, scenario=dataclasses.replace(scenario, faults=[]))
+
+
+SCENARIO_FIELDS = tuple(f.name for f in dataclasses.fields(Scenario))
+
+
+def configure(mission, like: TrialConfig, scenario_file: Path | None, seed: int | None, duration: float | None,
+              settings: list[str], faults: list[str]) -> TrialConfig:
+    """The trial configuration of a run, for a mission that supports scenarios, in the command line's precedence
+    (teamsim/cli/scenario.py): the file (or the world the mission makes of ``like``'s parameters), then ``seed`` and
+    ``duration``, then each ``KEY=VALUE`` of ``settings`` in order, then ``faults`` (specs) after the scenario's.
+    ``like`` holds the run's other settings (mission parameters, output folder, video)."""
+    if not supports(mission):
+        raise not_supported(mission)
+    parsed = [parse_fault(spec) for spec in faults]
+    legacy = set(settable_keys(like)) if not scenario_file else set()
+    paths = []
+    for assignment in settings:
+        key = assignment.partition("=")[0].strip()
+        bare_unknown = not scenario_file and key.isidentifier() and key not in SCENARIO_FIELDS
+        if key.startswith("video.") or key in legacy or bare_unknown:
+            apply_setting(like, assignment)  # (a bare unknown key gets its error listing the settable keys)
+        else:
+            paths.append(assignment)
+    validate(like)
+    if scenario_file:
+        data, base = read(scenario_file), Path(scenario_file).parent
+        for name, value in (("seed", seed), ("duration", duration)):
+            if value is not None:
+                if not isinstance(data, dict):
+                    raise ConfigError(f"{scenario_file}: expected a mapping of scenario fields")
+                data[name] = value
+        like = dataclasses.replace(like, params=None)  # the file, not the mission's parameters, is the world
+    else:
+        data, base = to_data(generate(dataclasses.replace(like, faults=parsed), mission)), None
+    for assignment in paths:
+        data = set_path(data, assignment)
+    return config_of(load(data, mission, base), mission, like, parsed)
 
 
 def resolve(config: TrialConfig, mission) -> TrialConfig:

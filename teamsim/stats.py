@@ -1,54 +1,46 @@
-"""Small statistics for study reports, in numpy alone: the paired two-sided t-test Chand uses (§3.6.2)."""
+"""Statistics for study reports, from ``scipy.stats``: the paired two-sided t-test Chand uses (§3.6.2) and a
+confidence interval for the ratio of two paired means."""
 from __future__ import annotations
 
 import math
+import warnings
 
 import numpy as np
-
-
-def _betacf(a: float, b: float, x: float) -> float:
-    """Continued fraction of the incomplete beta function (Lentz's method; Numerical Recipes §6.4)."""
-    tiny, qab, qap, qam = 1e-300, a + b, a + 1.0, a - 1.0
-    c, d = 1.0, 1.0 - qab * x / qap
-    d = 1.0 / (d if abs(d) > tiny else tiny)
-    h = d
-    for m in range(1, 300):
-        m2 = 2 * m
-        for numerator in (m * (b - m) * x / ((qam + m2) * (a + m2)),
-                          -(a + m) * (qab + m) * x / ((a + m2) * (qap + m2))):
-            d = 1.0 + numerator * d
-            d = 1.0 / (d if abs(d) > tiny else tiny)
-            c = 1.0 + numerator / c
-            c = c if abs(c) > tiny else tiny
-            h *= d * c
-        if abs(d * c - 1.0) < 1e-12:
-            break
-    return h
-
-
-def incomplete_beta(a: float, b: float, x: float) -> float:
-    """The regularised incomplete beta function I_x(a, b)."""
-    if x <= 0.0:
-        return 0.0
-    if x >= 1.0:
-        return 1.0
-    front = math.exp(math.lgamma(a + b) - math.lgamma(a) - math.lgamma(b) + a * math.log(x) + b * math.log(1 - x))
-    if x < (a + 1.0) / (a + b + 2.0):
-        return front * _betacf(a, b, x) / a
-    return 1.0 - front * _betacf(b, a, 1.0 - x) / b
+from scipy import stats
 
 
 def paired_t_test(a, b) -> tuple[float, float]:
     """(t, two-sided p) for the mean of the paired differences a - b; p = nan with fewer than two pairs,
     p = 1 (or 0) when every difference is the same zero (or non-zero) value."""
     diff = np.asarray(a, float) - np.asarray(b, float)
-    n = len(diff)
-    if n < 2:
+    if len(diff) < 2:
         return math.nan, math.nan
-    sd = float(diff.std(ddof=1))
-    mean = float(diff.mean())
-    if sd == 0.0:
+    if diff.std() == 0.0:  # scipy returns nan here
+        mean = float(diff.mean())
         return (0.0, 1.0) if mean == 0.0 else (math.copysign(math.inf, mean), 0.0)
-    t = mean / (sd / math.sqrt(n))
-    dof = n - 1
-    return t, incomplete_beta(dof / 2, 0.5, dof / (dof + t * t))
+    with warnings.catch_warnings():  # differences equal but for rounding: a huge t, and scipy warns of it
+        warnings.filterwarnings("ignore", "Precision loss", RuntimeWarning)
+        result = stats.ttest_rel(a, b)
+    return float(result.statistic), float(result.pvalue)
+
+
+def ratio_ci(a, b, level: float = 0.95) -> tuple[float, float, float]:
+    """(mean(a) / mean(b), low, high): Fieller's confidence interval for the ratio of two paired means, the ratios
+    R that the paired t-test of a against R b does not reject at 1 - ``level``. Low and high are infinite when
+    mean(b) itself is not clearly away from zero (the interval is unbounded); all three nan with fewer than two
+    pairs or mean(b) = 0."""
+    a, b = np.asarray(a, float), np.asarray(b, float)
+    n = len(a)
+    if n < 2 or b.mean() == 0.0:
+        return math.nan, math.nan, math.nan
+    ratio = float(a.mean() / b.mean())
+    (s_aa, s_ab), (_, s_bb) = np.cov(a, b, ddof=1)
+    q = stats.t.ppf(0.5 + level / 2, n - 1) ** 2 / n
+    # (mean(a) - R mean(b))^2 <= q var(a - R b), a quadratic in R: A R^2 - 2 B R + C <= 0.
+    quad = b.mean() ** 2 - q * s_bb
+    half = b.mean() * a.mean() - q * s_ab
+    const = a.mean() ** 2 - q * s_aa
+    if quad <= 0.0:
+        return ratio, -math.inf, math.inf
+    root = math.sqrt(max(half * half - quad * const, 0.0))
+    return ratio, float((half - root) / quad), float((half + root) / quad)

@@ -1,4 +1,5 @@
-"""``timeline.png``: what each robot did over time, with faults marked, drawn with OpenCV from the recorded trial.
+"""``timeline.png`` and ``timeline.svg``: what each robot did over time, with faults marked, drawn with matplotlib
+from the recorded trial.
 
 A robot whose controller returned a motivation trace (``Command.trace``: ALLIANCE, L-ALLIANCE) gets one row per
 behaviour set, in the style of the action-selection figures of Parker's thesis (Figs 3-9, 3-10, 3-13): a bar
@@ -12,24 +13,24 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Mapping
 
-import cv2
 import numpy as np
 
-from teamsim.files import write_atomic
+from teamsim.plots import pyplot, save_figure
 from teamsim.recording import MotivationSeries
 
-_FONT = cv2.FONT_HERSHEY_SIMPLEX
-# Distinct colours (BGR) for behaviours, in order of first appearance; idle, dead and absent are fixed greys.
-_PALETTE = [(180, 119, 31), (14, 127, 255), (44, 160, 44), (40, 39, 214), (189, 103, 148), (75, 86, 140),
-            (194, 119, 227), (34, 189, 188), (207, 190, 23), (127, 127, 127)]
-_FIXED = {"idle": (225, 225, 225), "absent": (245, 245, 245), "dead": (60, 60, 60)}
-_BLACK, _RED, _GREY = (0, 0, 0), (0, 0, 255), (150, 150, 150)
-_RESET, _RATE = (160, 40, 120), (0, 140, 230)  # impatience reset, impatience rate change
-ROW, SET_ROW, TOP, WIDTH, GAP = 34, 36, 40, 1000, 8
+# Distinct colours for behaviours, in order of first appearance; idle, dead and absent are fixed greys.
+_PALETTE = ["#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b", "#e377c2", "#bcbd22", "#17becf",
+            "#7f7f7f"]
+_FIXED = {"idle": "#e1e1e1", "absent": "#f5f5f5", "dead": "#3c3c3c"}
+_RED, _GREY, _RESET, _RATE = "#ff0000", "#969696", "#7828a0", "#e68c00"  # faults, theta, impatience reset, rate
+GAP = 0.3  # between robots, in rows
+ROW_INCHES = 0.36
+WIDTH = 11.5  # in
+MARGIN = 0.08  # of a row, above and below its bar
 THETA_HEIGHT = 0.6  # theta is drawn at this fraction of a set row's height; higher motivations are clipped
 
 
-def behaviour_colours(names) -> dict[str, tuple[int, int, int]]:
+def behaviour_colours(names) -> dict[str, str]:
     """A colour per name (behaviour or behaviour set), in order of first appearance."""
     colours, k = {}, 0
     for name in dict.fromkeys(names):
@@ -41,170 +42,147 @@ def behaviour_colours(names) -> dict[str, tuple[int, int, int]]:
     return colours
 
 
-def _text(image, text: str, x: int, y: int, scale: float = 0.45, colour=_BLACK) -> None:
-    cv2.putText(image, text, (x, y), _FONT, scale, colour, 1, cv2.LINE_AA)
-
-
-def _text_width(text: str, scale: float) -> int:
-    return cv2.getTextSize(text, _FONT, scale, 1)[0][0]
-
-
 def _runs(values: np.ndarray) -> list[tuple[int, int]]:
     """(start, stop) index ranges over which ``values`` is constant."""
     changes = np.flatnonzero(values[1:] != values[:-1]) + 1
     return list(zip(np.r_[0, changes].tolist(), np.r_[changes, len(values)].tolist()))
 
 
-def _lighter(colour, amount: float = 0.6) -> tuple[int, int, int]:
-    return tuple(int(round(c + (255 - c) * amount)) for c in colour)
-
-
 def draw_timeline(times: np.ndarray, behaviours: np.ndarray, robot_names: list[str], faults: list[dict],
-                  motivation: Mapping[str, MotivationSeries] | None = None) -> np.ndarray:
-    """A BGR image: per robot one row coloured by behaviour, or (with a motivation series) one row per behaviour
-    set with active bars, m(t), theta and the events; faults as labelled red lines."""
+                  motivation: Mapping[str, MotivationSeries] | None = None):
+    """A matplotlib figure: per robot one row coloured by behaviour, or (with a motivation series) one row per
+    behaviour set with active bars, m(t), theta and the events; faults as labelled red lines. Rows run down from
+    y = 0, one unit each; time is x, in seconds."""
     motivation = motivation or {}
     names = behaviours.T.ravel().tolist() if behaviours.size else []
     colours = behaviour_colours(names + [s for series in motivation.values() for s in series.sets])
-    robot_col = max([_text_width(n, 0.5) for n in robot_names] + [40]) + 16
-    set_labels = [s for r in robot_names if r in motivation for s in motivation[r].sets]
-    left = robot_col + (max(_text_width(s, 0.4) for s in set_labels) + 12 if set_labels else 0)
-    rows = [(ROW if r not in motivation else SET_ROW * len(motivation[r].sets)) for r in robot_names]
-    tops = TOP + np.cumsum([0] + [h + GAP for h in rows[:-1]]).astype(int)
-    axis_y = int(tops[-1] + rows[-1] + 4) if robot_names else TOP
-    legend = _legend_layout(list(colours), WIDTH)
-    legend_rows = (legend[-1][1] + 1 if legend else 0) + (1 if motivation else 0)
-    image = np.full((axis_y + 40 + 22 * legend_rows, left + WIDTH + 20, 3), 255, np.uint8)
+    heights = [len(motivation[r].sets) if r in motivation else 1 for r in robot_names]
+    tops = np.cumsum([0.0] + [h + GAP for h in heights[:-1]])
+    bottom = float(tops[-1] + heights[-1]) if robot_names else 1.0
     end = float(times[-1]) if len(times) > 1 else 1.0
 
-    def x_of(t: float) -> int:
-        return left + int(round(WIDTH * min(t, end) / end))
-
+    plt = pyplot()
+    longest = max((_width(name, 8) for name in colours), default=0.0)
+    columns = int(max(1, min(8, (WIDTH - 1) * 72 // (longest + 40))))  # colour keys a row: as many as fit, up to 8
+    key_rows = max(-(-len(colours) // columns) + bool(motivation), 1)
+    fig, (axes, key) = plt.subplots(2, 1, figsize=(WIDTH, 1.1 + ROW_INCHES * bottom + 0.22 * key_rows),
+                                    height_ratios=[ROW_INCHES * bottom + 0.5, 0.22 * key_rows], layout="constrained")
     title = "active behaviour"
     if motivation:
         title += "; behaviour sets: active (bars), motivation m(t) (curves), threshold theta (dashed)"
-    _text(image, title, left, 24, 0.5)
-    for row, (name, top, height) in enumerate(zip(robot_names, tops, rows)):
-        _text(image, name, 8, int(top) + min(height, ROW) // 2 + 5, 0.5)
+    axes.set_title(title, loc="left", fontsize=10)
+    set_ticks, set_labels = [], []
+    for row, (name, top, height) in enumerate(zip(robot_names, tops, heights)):
         if name in motivation:
-            _draw_sets(image, motivation[name], int(top), left, end, x_of, colours)
-            _shade_absence(image, times, behaviours[:, row], int(top), height, end, x_of)
+            _draw_sets(axes, name, motivation[name], top, end, colours)
+            _shade_absence(axes, times, behaviours[:, row], top, height, end)
+            set_ticks += [top + k + 0.5 for k in range(height)]
+            set_labels += motivation[name].sets
         else:
             column = behaviours[:, row]
             for start, stop in _runs(column):
                 t1 = times[stop] if stop < len(times) else end
-                cv2.rectangle(image, (x_of(times[start]), int(top) + 4), (x_of(t1), int(top) + height - 4),
-                              colours[column[start]], -1)
-    cv2.line(image, (left, axis_y), (left + WIDTH, axis_y), _BLACK, 1)
-    step = _nice_step(end)
-    for t in np.arange(0.0, end + 1e-9, step):
-        cv2.line(image, (x_of(t), axis_y), (x_of(t), axis_y + 5), _BLACK, 1)
-        _text(image, f"{t:g}", x_of(t) - 8, axis_y + 18, 0.4)
-    _text(image, "s", left + WIDTH + 12, axis_y + 18, 0.4)
+                axes.broken_barh([(times[start], t1 - times[start])], (top + MARGIN, 1 - 2 * MARGIN),
+                                 color=colours[column[start]], gid=f"behaviour/{name}")
     for fault in faults:
         if fault["robot"] in robot_names and fault["time"] <= end:
             k = robot_names.index(fault["robot"])
-            x, y = x_of(fault["time"]), int(tops[k])
-            cv2.line(image, (x, y), (x, y + rows[k]), _RED, 2)
-            _text(image, fault["kind"], x + 3, y + 12, 0.35, _RED)
-    for (name, colour), (offset, line) in zip(colours.items(), legend):
-        x, y = left + offset, axis_y + 32 + 22 * line
-        cv2.rectangle(image, (x, y - 10), (x + 14, y + 2), colour, -1)
-        cv2.rectangle(image, (x, y - 10), (x + 14, y + 2), _BLACK, 1)
-        _text(image, name, x + 20, y)
-    if motivation:
-        _marker_legend(image, left, axis_y + 32 + 22 * (legend_rows - 1))
-    return image
+            axes.vlines(fault["time"], tops[k], tops[k] + heights[k], color=_RED, lw=2, gid="fault")
+            axes.text(fault["time"], tops[k] + 0.05, f" {fault['kind']}", color=_RED, fontsize=7, va="top")
+    axes.set(xlim=(0, end), ylim=(bottom, 0), xlabel="time (s)")
+    axes.set_yticks(set_ticks, set_labels, fontsize=8)
+    robots = axes.secondary_yaxis("left")
+    robots.set_yticks(tops + np.array(heights) / 2, robot_names, fontsize=10)
+    robots.tick_params(length=0, pad=4 + max([_width(label, 8) for label in set_labels], default=0))
+    for spine in (*axes.spines.values(), robots.spines["left"]):
+        spine.set_visible(spine is axes.spines["bottom"])
+    axes.tick_params(axis="y", length=0)
+    _legend(key, colours, bool(motivation), columns)
+    return fig
 
 
-def _draw_sets(image: np.ndarray, series: MotivationSeries, top: int, left: int, end: float, x_of,
-               colours: dict) -> None:
-    """One robot's behaviour-set rows: label, active bars, theta, m(t) and the events."""
+def _draw_sets(axes, robot: str, series: MotivationSeries, top: float, end: float, colours: dict) -> None:
+    """One robot's behaviour-set rows: active bars, theta, m(t) and the events."""
     times = np.frombuffer(series.times, dtype=float)
     levels = series.level_array()
     active = np.frombuffer(series.active, dtype=np.int32)
-    scale = THETA_HEIGHT * (SET_ROW - 6) / series.threshold
+    span = 1 - 2 * MARGIN
 
-    def y_of(row: int, m) -> np.ndarray:
-        bottom = top + row * SET_ROW + SET_ROW - 3
-        return np.round(bottom - np.minimum(m * scale, SET_ROW - 6)).astype(np.int32)
+    def y_of(row: int, m):
+        return top + row + 1 - MARGIN - np.minimum(np.asarray(m) * THETA_HEIGHT * span / series.threshold, span)
 
-    xs = np.array([x_of(t) for t in times], dtype=np.int32)
-    # The trace stops when the controller does (a dead robot): the last step lasts one control period.
-    last = times[-1] + (times[-1] - times[-2]) if len(times) > 1 else end
+    # The trace pauses while the controller does not run (a dead or removed robot).
+    step = float(np.median(np.diff(times))) if len(times) > 1 else end
+    breaks = np.flatnonzero(np.diff(times) > 1.5 * step) + 1
+    periods = list(_periods(times, active, breaks, step))
     for k, name in enumerate(series.sets):
-        y = top + k * SET_ROW
-        _text(image, name, left - 6 - _text_width(name, 0.4), y + SET_ROW // 2 + 4, 0.4)
-        cv2.line(image, (left, y + SET_ROW - 3), (x_of(end), y + SET_ROW - 3), (210, 210, 210), 1)
-        light = _lighter(colours[name])
-        for start, stop in _runs(active):
-            if active[start] == k:
-                t1 = times[stop] if stop < len(times) else last
-                cv2.rectangle(image, (xs[start], y + 3), (x_of(t1), y + SET_ROW - 3), light, -1)
-        theta_y = int(y_of(k, series.threshold))
-        for x in range(left, x_of(end), 8):
-            cv2.line(image, (x, theta_y), (min(x + 4, x_of(end)), theta_y), _GREY, 1)
+        y = top + k
+        axes.hlines(y + 1 - MARGIN, 0, end, color="#d2d2d2", lw=0.8)
+        axes.broken_barh([(t0, t1 - t0) for value, t0, t1 in periods if value == k], (y + MARGIN, span),
+                         color=colours[name], alpha=0.4, lw=0, gid=f"active/{robot}/{name}")
+        axes.hlines(y_of(k, series.threshold), 0, end, color=_GREY, lw=0.8, linestyles=(0, (4, 4)))
         if len(times):
-            curve = np.stack([xs, y_of(k, levels[:, k])], axis=1)
-            cv2.polylines(image, [curve], False, colours[name], 1, cv2.LINE_AA)
-    for time, k, kind, detail in series.events:
-        x, y = x_of(time), top + k * SET_ROW
-        if kind == "impatience_reset":
-            cv2.fillPoly(image, [np.array([(x - 4, y + 3), (x + 4, y + 3), (x, y + 9)], np.int32)], _RESET)
-        elif kind == "impatience":
-            cv2.line(image, (x, y + SET_ROW - 8), (x, y + SET_ROW - 1), _RATE, 2)
-        elif kind == "acquiescence":
-            cv2.line(image, (x - 4, y + 5), (x + 4, y + 13), _RED, 2)
-            cv2.line(image, (x - 4, y + 13), (x + 4, y + 5), _RED, 2)
-            _text(image, "psi" if detail == "psi" else "lambda", x + 6, y + 13, 0.35, _RED)
+            axes.plot(np.insert(times, breaks, np.nan), np.insert(y_of(k, levels[:, k]), breaks, np.nan),
+                      color=colours[name], lw=1, gid=f"motivation/{robot}/{name}")
+    for kind, marker, colour, where in (("impatience_reset", "v", _RESET, MARGIN + 0.12),
+                                        ("impatience", "|", _RATE, 1 - MARGIN - 0.1),
+                                        ("acquiescence", "x", _RED, 0.35)):
+        chosen = [(time, k, detail) for time, k, event, detail in series.events if event == kind]
+        if chosen:
+            axes.plot([t for t, _, _ in chosen], [top + k + where for _, k, _ in chosen], ls="none", marker=marker,
+                      color=colour, ms=6, mew=2 if marker != "v" else 1, gid=f"{kind}/{robot}")
+        if kind == "acquiescence":
+            for time, k, detail in chosen:
+                axes.text(time, top + k + where, "  psi" if detail == "psi" else "  lambda", color=_RED, fontsize=7,
+                          va="center")
 
 
-def _shade_absence(image: np.ndarray, times: np.ndarray, column: np.ndarray, top: int, height: int, end: float,
-                   x_of) -> None:
-    """Hatch the robot's rows where it is dead or not in the arena (its controller does not run)."""
+def _periods(times: np.ndarray, values: np.ndarray, breaks: np.ndarray, step: float):
+    """(value, start, end) of each run of constant ``values``, split where the trace pauses (at ``breaks``): the
+    last tick before a pause, or the end, lasts one control period ``step``."""
+    for first, stop in zip(np.r_[0, breaks].tolist(), np.r_[breaks, len(times)].tolist()):
+        for a, b in _runs(values[first:stop]):
+            yield values[first + a], times[first + a], times[first + b] if first + b < stop else times[stop - 1] + step
+
+
+def _shade_absence(axes, times: np.ndarray, column: np.ndarray, top: float, height: int, end: float) -> None:
+    """Shade the robot's rows where it is dead or not in the arena (its controller does not run)."""
     for start, stop in _runs(column):
-        if column[start] in ("dead", "absent"):
-            x0, x1 = x_of(times[start]), x_of(times[stop] if stop < len(times) else end)
-            overlay = image[top:top + height, x0:x1]
-            overlay[:] = (overlay * 0.55 + np.array(_FIXED[column[start]]) * 0.45).astype(np.uint8)
-            _text(image, str(column[start]), x0 + 3, top + height - 5, 0.35, (255, 255, 255) if
-                  column[start] == "dead" else _BLACK)
+        state = column[start]
+        if state in ("dead", "absent"):
+            t1 = times[stop] if stop < len(times) else end
+            axes.broken_barh([(times[start], t1 - times[start])], (top, height), color=_FIXED[state], alpha=0.45,
+                             lw=0, gid=state)
+            axes.text(times[start], top + height - 0.1, f" {state}", fontsize=7,
+                      color="white" if state == "dead" else "black")
 
 
-def _legend_layout(names: list[str], width: int) -> list[tuple[int, int]]:
-    """(x offset, line) of each colour key: entries on a 165 px grid, wider ones taking more cells, wrapping at
-    ``width``."""
-    places, x, line = [], 0, 0
-    for name in names:
-        cells = 165 * -(-(_text_width(name, 0.45) + 30) // 165)
-        if x and x + cells > width:
-            x, line = 0, line + 1
-        places.append((x, line))
-        x += cells
-    return places
+def _legend(key, colours: dict, motivation: bool, columns: int) -> None:
+    """Under the plot: a colour key per behaviour (or set), and with motivation a row of the event markers."""
+    from matplotlib.lines import Line2D  # noqa: PLC0415
+    from matplotlib.patches import Patch  # noqa: PLC0415
+
+    key.axis("off")
+    swatches = [Patch(facecolor=colour, edgecolor="black", lw=0.6, label=name) for name, colour in colours.items()]
+    shown = key.legend(handles=swatches, loc="upper left", ncol=columns, fontsize=8, frameon=False,
+                       borderaxespad=0, handlelength=1.2)
+    if motivation:
+        key.add_artist(shown)
+        markers = [Line2D([], [], ls="none", marker=marker, mew=width, color=colour, label=label)
+                   for marker, width, colour, label in (("v", 1, _RESET, "impatience reset (teammate first heard)"),
+                                                        ("|", 2, _RATE, "impatience rate changes (slow/fast)"),
+                                                        ("x", 2, _RED, "acquiescence (psi or lambda)"))]
+        key.legend(handles=markers, loc="lower left", ncol=3, fontsize=8, frameon=False, borderaxespad=0)
 
 
-def _marker_legend(image: np.ndarray, x: int, y: int) -> None:
-    cv2.fillPoly(image, [np.array([(x, y - 9), (x + 8, y - 9), (x + 4, y - 3)], np.int32)], _RESET)
-    _text(image, "impatience reset (teammate first heard)", x + 14, y)
-    x += 300
-    cv2.line(image, (x + 4, y - 10), (x + 4, y + 2), _RATE, 2)
-    _text(image, "impatience rate changes (slow/fast)", x + 14, y)
-    x += 270
-    cv2.line(image, (x, y - 9), (x + 8, y - 1), _RED, 2)
-    cv2.line(image, (x, y - 1), (x + 8, y - 9), _RED, 2)
-    _text(image, "acquiescence (psi or lambda)", x + 14, y)
+def _width(text: str, size: float) -> float:
+    """The width of ``text`` in points at font size ``size``."""
+    from matplotlib.textpath import TextPath  # noqa: PLC0415
 
-
-def _nice_step(span: float) -> float:
-    raw = span / 10
-    magnitude = 10 ** np.floor(np.log10(raw)) if raw > 0 else 1.0
-    return float(min((m * magnitude for m in (1, 2, 5, 10) if m * magnitude >= raw), default=magnitude))
+    return TextPath((0, 0), text, size=size).get_extents().width
 
 
 def write_timeline(path: Path, times, behaviours, robot_names, faults,
                    motivation: Mapping[str, MotivationSeries] | None = None) -> None:
-    image = draw_timeline(np.asarray(times), np.asarray(behaviours), robot_names, faults, motivation)
-    ok, png = cv2.imencode(".png", image)
-    if ok:
-        write_atomic(path, png.tobytes())
+    """The timeline as ``path`` (PNG) and beside it the same stem ``.svg``."""
+    save_figure(draw_timeline(np.asarray(times), np.asarray(behaviours), robot_names, faults, motivation), Path(path))

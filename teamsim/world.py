@@ -261,6 +261,12 @@ class World:
     # -- the control tick -----------------------------------------------------------------------------------
     def tick(self) -> None:
         """Apply due faults, sense, decide and set actuators, at the current time."""
+        for robot, observation in self.observe():
+            self.act(robot, observation, robot.controller(observation))
+
+    def observe(self):
+        """Apply due faults and sample every sensor, then yield ``(robot, Observation)`` for each live robot, in
+        team order. Lazily: :meth:`tick` acts on each robot before the next one's observation is built."""
         self.check_stable()
         now = self.time
         while self.faults and self.faults[0].time <= now + 1e-9:
@@ -279,7 +285,7 @@ class World:
             self._touching_s[k] += self.control_dt
         touch = self._touch_forces()
         for robot, (raw, ranges) in zip(live, self._read_ir(live)):
-            self._control(robot, now, raw, ranges, touch[self._index_of[robot.name]])
+            yield robot, self._observation(robot, now, raw, ranges, touch[self._index_of[robot.name]])
 
     def _read_ir(self, robots: list[Robot]) -> list[tuple[np.ndarray, np.ndarray]]:
         """(raw, range) IR readings per robot, one vectorised IR-model call per sensor model."""
@@ -299,10 +305,11 @@ class World:
                 readings[k] = (raw[lo:hi], ranges[lo:hi])
         return readings
 
-    def _control(self, robot: Robot, now: float, ir_raw: np.ndarray, ir_range: np.ndarray, touch: dict) -> None:
+    def _observation(self, robot: Robot, now: float, ir_raw: np.ndarray, ir_range: np.ndarray,
+                     touch: dict) -> Observation:
         d, spec = self.data, robot.model
         beams = d.sensordata[robot.beam_adr]
-        observation = Observation(
+        return Observation(
             time=now, robot=robot.name, ir_raw=ir_raw, ir_range=ir_range,
             ir_bearings=spec.ir_bearings, pose=self.positioning.fix(robot.name),
             inbox=tuple(self.radio.take_inbox(robot.name)),
@@ -313,7 +320,11 @@ class World:
             effectors={name: self._effector_position(robot, name) for name in robot.effectors},
             drive_effort=self._drive_effort(robot),
             signals=self._sense(self, robot.name) if self._sense is not None else {})
-        command: Command = robot.controller(observation)
+
+    def act(self, robot: Robot, observation: Observation, command: Command) -> None:
+        """Carry out ``command``, the answer to ``observation``: record its behaviour, queue its broadcast, set the
+        locomotion and effector set-points."""
+        now = observation.time
         if not (math.isfinite(command.v) and math.isfinite(command.omega)):
             raise ValueError(f"controller of {robot.name} returned a non-finite command {command}")
         if command.trace is not None:
@@ -334,7 +345,7 @@ class World:
         if hasattr(robot.drive, "feedback"):
             robot.drive.feedback(self.yaw_rate(robot))
         robot.drive.command(command.v * factor, command.omega * factor)
-        d.ctrl[robot.actuators] = robot.drive.targets(now)
+        self.data.ctrl[robot.actuators] = robot.drive.targets(now)
         for name, setpoint in command.extras.items():
             self._set_effector(robot, name, setpoint)
 

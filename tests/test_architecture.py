@@ -20,7 +20,7 @@ FOUNDATION = ("teamsim", "teamsim.config", "teamsim.rng", "teamsim.files", "team
               "teamsim.stats", "teamsim.plots", "teamsim.positioning", "teamsim.radio", "teamsim.network",
               "teamsim.faults")
 RUNTIME = ("teamsim.world", "teamsim.runner", "teamsim.recording", "teamsim.timeline", "teamsim.video",
-           "teamsim.rerender", "teamsim.sweep")
+           "teamsim.rerender", "teamsim.sweep", "teamsim.viewer", "teamsim.env")
 LAYER_OF = {  # module or package (its modules too; "teamsim" alone) -> layer; the longest prefix wins
     **{name: "foundation" for name in FOUNDATION},
     "teamsim.models": "models",

@@ -172,6 +172,10 @@ class BoxPushingMission(ScenarioMission):
         x, y, _ = self.box_pose(world)
         return (x - x0) * math.cos(yaw0) + (y - y0) * math.sin(yaw0)
 
+    def progress(self, world) -> float:
+        """The box's advance out of the set distance, in [0, 1] (the reward of ``teamsim.env``)."""
+        return min(1.0, max(0.0, self.advance(world) / world.scene.scenario.task.advance))
+
     def entry_pose(self, world, name: str) -> tuple[float, float, float]:
         """Where a robot joining (add-robot) or put back (revive after remove) is set down: behind the end of the
         box with no live robot within ``CLEAR`` of its pushing spot (its own start end first), facing the box.

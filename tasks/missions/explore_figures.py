@@ -1,6 +1,6 @@
-"""The explore mission's pictures (drawn with OpenCV, as every teamsim figure): ``map.png``, the manager's final
-global map with each environment's status, the bogs found and each robot's path; ``coverage.png``, the explored
-share over time with the team's events marked."""
+"""The explore mission's pictures: ``map.png``, the manager's final global map with each environment's status, the
+bogs found and each robot's path, and ``coverage.png``, the explored share over time with the team's events marked
+(matplotlib, each also as ``.svg``); the video's side panel, the same map drawn with OpenCV."""
 from __future__ import annotations
 
 from pathlib import Path
@@ -9,14 +9,15 @@ import cv2
 import numpy as np
 
 from teamsim.controllers.exploration.territory import Territory
-from teamsim.files import write_atomic
-from teamsim.plots import line_chart
+from teamsim.plots import line_chart, pyplot, save_figure
 
 CELL_PX = 5  # pixels per map cell
 STATUS_BGR = {"E": (60, 160, 60), "PE": (0, 140, 255), "UE": (40, 40, 200), "assigned": (200, 120, 0)}
 ROBOT_BGR = [(180, 119, 31), (14, 127, 255), (44, 160, 44), (40, 39, 214), (189, 103, 148), (75, 86, 140),
              (194, 119, 227), (127, 127, 127)]
 BOG_BGR = (30, 70, 140)
+STATUS_RGB = {"E": "#3ca03c", "PE": "#ff8c00", "UE": "#c82828", "assigned": "#0078c8"}  # STATUS_BGR's
+BOG_RGB = "#8c461e"
 _FONT = cv2.FONT_HERSHEY_SIMPLEX
 
 
@@ -51,16 +52,33 @@ def map_image(probabilities: np.ndarray, territory: Territory, status, boggy, tr
 
 def write_map(path: Path, probabilities: np.ndarray, territory: Territory, status, boggy, trails: dict,
               bogs=()) -> None:
-    image = map_image(probabilities, territory, status, boggy, trails, bogs)
-    legend = np.full((image.shape[0], 200, 3), 255, np.uint8)
-    rows = [(f"{name}", ROBOT_BGR[k % len(ROBOT_BGR)]) for k, name in enumerate(trails)]
-    rows += [("explored (E)", STATUS_BGR["E"]), ("partly (PE)", STATUS_BGR["PE"]),
-             ("unexplored (UE)", STATUS_BGR["UE"]), ("true bog", BOG_BGR)]
-    for k, (text, colour) in enumerate(rows):
-        y = 30 + 24 * k
-        cv2.line(legend, (10, y - 5), (40, y - 5), colour, 3)
-        cv2.putText(legend, text, (48, y), _FONT, 0.5, (0, 0, 0), 1, cv2.LINE_AA)
-    write_atomic(path, cv2.imencode(".png", np.hstack([image, legend]))[1].tobytes())
+    """The map (white free, black occupied, grey unexplored; world y up, in metres), the true bogs outlined, each
+    robot's path, and each environment outlined in its status's colour and labelled, with a key on the right."""
+    plt = pyplot()
+    rows, cols = probabilities.shape
+    x0, y0 = territory.origin
+    side = 8.0 * cols / max(rows, cols)
+    fig, axes = plt.subplots(figsize=(side + 2.2, 8.0 * rows / max(rows, cols) + 0.3), layout="constrained")
+    axes.imshow(1.0 - probabilities, cmap="gray", vmin=0, vmax=1, origin="lower", interpolation="nearest",
+                extent=(x0, x0 + cols * territory.resolution, y0, y0 + rows * territory.resolution))
+    for bog in bogs:
+        axes.add_patch(plt.Rectangle((bog.x - bog.half_x, bog.y - bog.half_y), 2 * bog.half_x, 2 * bog.half_y,
+                                     fill=False, ec=BOG_RGB, lw=2))
+    for k, (name, points) in enumerate(trails.items()):
+        xy = np.array(points).reshape(-1, 2)
+        axes.plot(xy[:, 0], xy[:, 1], color=f"C{k % len(ROBOT_BGR)}", lw=2, label=name)
+    for e in range(territory.environments):
+        (x_lo, y_lo), (x_hi, y_hi) = territory.bounds(e)
+        colour = STATUS_RGB.get(status[e], "black")
+        axes.add_patch(plt.Rectangle((x_lo, y_lo), x_hi - x_lo, y_hi - y_lo, fill=False, ec=colour, lw=2))
+        axes.annotate(f"{e} {status[e]}" + (" bog" if boggy[e] else ""), (x_lo, y_hi), xytext=(4, -4),
+                      textcoords="offset points", va="top", fontsize=8, color=colour)
+    for label, status_key in (("explored (E)", "E"), ("partly (PE)", "PE"), ("unexplored (UE)", "UE")):
+        axes.plot([], [], color=STATUS_RGB[status_key], lw=3, label=label)
+    axes.plot([], [], color=BOG_RGB, lw=3, label="true bog")
+    axes.set(xlabel="x (m)", ylabel="y (m)", aspect="equal")
+    axes.legend(loc="upper left", bbox_to_anchor=(1.01, 1), frameon=False)
+    save_figure(fig, path)
 
 
 def panel_image(global_info, territory: Territory, trails: dict, roles: dict, time: float) -> np.ndarray:

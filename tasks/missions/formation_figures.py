@@ -1,5 +1,6 @@
 """Pictures of the ``formation`` mission: the video's side panel (OpenCV, drawn every second: the line around its
-leader) and ``formation.png`` (matplotlib): the paths from above beside the formation error fe_t over time."""
+leader) and ``formation.png`` + ``.svg`` (matplotlib): the paths from above beside the formation error fe_t over
+time."""
 from __future__ import annotations
 
 import math
@@ -8,23 +9,13 @@ from pathlib import Path
 import cv2
 import numpy as np
 
-from teamsim.files import write_atomic
+from teamsim.plots import pyplot, save_figure
 
 PANEL = 480  # px, the side panel's height and width
 PANEL_SPAN = 12.0  # m of floor across the panel, centred on the leader
 ROUTE_BGR, GREY, BLACK = (30, 180, 230), (150, 150, 150), (0, 0, 0)
 TAB10 = ((0.12, 0.47, 0.71), (1.0, 0.5, 0.05), (0.17, 0.63, 0.17), (0.84, 0.15, 0.16), (0.58, 0.4, 0.74),
          (0.55, 0.34, 0.29), (0.89, 0.47, 0.76), (0.5, 0.5, 0.5), (0.74, 0.74, 0.13), (0.09, 0.75, 0.81))
-
-
-def pyplot():
-    """matplotlib's pyplot on the Agg backend, imported when a figure is drawn (it costs half a second)."""
-    import matplotlib  # noqa: PLC0415
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt  # noqa: PLC0415
-
-    return plt
 
 
 def _box_corners(box) -> np.ndarray:
@@ -72,7 +63,7 @@ def panel_image(scenario, info: dict, places: dict, time: float) -> np.ndarray:
 
 
 def write_formation(path: Path, scenario, info: dict) -> None:
-    """``formation.png``: the paths from above (route dashed, obstacles grey) and fe_t per second."""
+    """``formation.png`` and ``.svg``: the paths from above (route dashed, obstacles grey) and fe_t per second."""
     plt = pyplot()
     fig, (top, curve) = plt.subplots(1, 2, figsize=(11, 4.5), gridspec_kw={"width_ratios": [1, 1.3]})
     for box in scenario.arena.boxes:
@@ -91,14 +82,4 @@ def write_formation(path: Path, scenario, info: dict) -> None:
     curve.set(xlabel="time (s)", ylabel="fe_t (m)", title=f"formation error, strategy {scenario.task.strategy}")
     curve.grid(alpha=0.3)
     fig.tight_layout()
-    write_figure(path, fig)
-
-
-def write_figure(path: Path, fig) -> None:
-    """A matplotlib figure as PNG, written atomically, and closed."""
-    from io import BytesIO
-
-    buffer = BytesIO()
-    fig.savefig(buffer, format="png", dpi=110)
-    pyplot().close(fig)
-    write_atomic(path, buffer.getvalue())
+    save_figure(fig, path)

@@ -206,6 +206,10 @@ class HazardousWasteMission(ScenarioMission):
         task = world.scene.scenario.task
         return sum(task.in_goal(*world.data.body(body).xpos[:2]) for body in world.scene.info["pucks"])
 
+    def progress(self, world) -> float:
+        """Pucks in the goal out of the target, in [0, 1] (the reward of ``teamsim.env``)."""
+        return min(1.0, self.pucks_at_goal(world) / world.scene.info["target"])
+
     def done(self, world) -> bool:
         if self.pucks_at_goal(world) < world.scene.info["target"]:
             return False

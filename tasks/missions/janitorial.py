@@ -256,10 +256,12 @@ class JanitorialMission(ScenarioMission):
                                     DIMS.cleaner_half_depth, DIMS.cleaner_half_width)
 
     # -- pictures ------------------------------------------------------------------------------------------------------
-    def _picture(self, world) -> np.ndarray:
+    @staticmethod
+    def _floor_state(world) -> tuple:
+        """What the floor pictures show: (info, can colours by frequency, live robots' positions, time)."""
         task = world.scene.scenario.task
         robots = {n: world.pose(r)[:2] for n, r in world.robots.items() if r.active}
-        return floor_image(world.scene.info, dict(zip(task.frequencies, FREQUENCY_RGBA)), robots, world.time)
+        return world.scene.info, dict(zip(task.frequencies, FREQUENCY_RGBA)), robots, world.time
 
     def video_panel(self, world) -> np.ndarray | None:
         """The floor as cleaned so far, the dusted furniture and the emptied cans, beside the 3-D view."""
@@ -267,11 +269,11 @@ class JanitorialMission(ScenarioMission):
         if world.time < info.get("panel_time", -math.inf) + PANEL_PERIOD:
             return None
         info["panel_time"] = world.time
-        return cv2.cvtColor(self._picture(world), cv2.COLOR_BGR2RGB)
+        return cv2.cvtColor(floor_image(*self._floor_state(world)), cv2.COLOR_BGR2RGB)
 
     def write_outputs(self, world, run_dir: Path) -> None:
         """``floor.png``: the floor, furniture and cans as the mission ended."""
-        write_floor(run_dir / "floor.png", self._picture(world))
+        write_floor(run_dir / "floor.png", *self._floor_state(world))
 
     def complete(self, world) -> bool:
         info, task = world.scene.info, world.scene.scenario.task

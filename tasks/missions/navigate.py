@@ -40,6 +40,8 @@ METHODS = {"FRC": dw.FRC, "RFRC": dw.RFRC, "ODW": dw.ODW, "ODWDS": dw.ODWDS, "HR
            "FRC-printed": dw.PrintedFRC}
 THESIS_METHODS = ("FRC", "RFRC", "ODW", "ODWDS", "HRDK", "HRDU")  # §3.6.2's six, the study's default
 NAV_KINDS = ("tricycle", "diffdrive", "tracked")
+GOAL_TOLERANCE = 0.5  # m beyond the footprint: "at the goal" (§3.6.2)
+STILL = 0.02  # m/s below which a robot stands still
 
 
 def robot_of(name: str) -> tuple[str, dict]:
@@ -145,8 +147,22 @@ class NavigateMission(ScenarioMission):
         return self._arrived(world) or world.time >= world.scene.info["time_limit"]
 
     def _arrived(self, world) -> bool:
-        controller = world.scene.info["controller"]
-        return bool(controller.arrived)
+        """The navigation controller says when its robot has stopped at the goal (§3.6.2). A robot driven by
+        anything else (an agent of ``teamsim.env``) has arrived when it stands still within the goal's tolerance."""
+        info = world.scene.info
+        robot = world.robots[info["robot"]]
+        if robot.controller is info["controller"]:
+            return bool(info["controller"].arrived)
+        x, y, _ = world.pose(robot)
+        near = math.dist((x, y), info["nav_world"].goal) <= GOAL_TOLERANCE + robot.model.footprint_radius
+        return near and world.speed(robot) < STILL
+
+    def progress(self, world) -> float:
+        """The share of the start-goal distance covered, in [0, 1] (the reward of ``teamsim.env``)."""
+        nav_world = world.scene.info["nav_world"]
+        x, y, _ = world.pose(world.robots[world.scene.info["robot"]])
+        start = math.dist(nav_world.start[:2], nav_world.goal)
+        return min(1.0, max(0.0, 1.0 - math.dist((x, y), nav_world.goal) / start)) if start > 0 else 1.0
 
     def outcome(self, world) -> tuple[bool, dict]:
         name = world.scene.info["robot"]
@@ -185,7 +201,7 @@ def nav_metrics(nav_world: NavWorld, robot: RobotModel, arrived: bool, pose, tra
     success) and AV (mean speed over v_gmax); for a failure, how it failed (``looping.failure_kind``) from the
     controller's ``trail`` of (time, x, y)."""
     x, y = pose[0], pose[1]
-    reached = arrived and math.dist((x, y), nav_world.goal) <= 0.5 + robot.footprint_radius
+    reached = arrived and math.dist((x, y), nav_world.goal) <= GOAL_TOLERANCE + robot.footprint_radius
     planned = optimal_path_length(nav_world, robot.footprint_radius)
     trail = np.asarray(trail, float).reshape(-1, 3)
     failure = {"failure": "", "loop_period": None, "loop_diameter": None} if reached else \

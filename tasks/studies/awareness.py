@@ -96,9 +96,9 @@ def pooled_ratio(rows: list[dict], numerator: str, denominator: str, version: st
     return sum(r[numerator] for r in chosen) / total if total else math.nan
 
 
-def paired_p(rows: list[dict], key: str, a: str, b: str) -> float:
-    """p of versions a and b differing in ``key``, paired by seed (both completed)."""
-    return findings.paired_p(rows, key, "version", a, b)
+def compare(rows: list[dict], key: str, a: str, b: str) -> findings.Comparison:
+    """Versions a and b in ``key``, paired by seed (both completed): p, and a's mean over b's with its 95 % CI."""
+    return findings.compare(rows, key, "version", a, b)
 
 
 def claims(rows: list[dict]) -> list[Finding]:
@@ -133,25 +133,25 @@ def claims(rows: list[dict]) -> list[Finding]:
                 fmt({v: done[v] for v in VERSIONS}) + f" of {runs['I']}",
                 verdict(sum(done[v] == runs[v] for v in VERSIONS), len(VERSIONS))),
         Finding("reports per move, 2 robots: about 0.58 with awareness (I), 0.86 without (III)", "I 0.58, III 0.86",
-                fmt(rpm, 2), rpm_i_iii, paired_p(rows, "reports_per_move", "III", "I")),
+                fmt(rpm, 2), rpm_i_iii, *compare(rows, "reports_per_move", "III", "I")),
         Finding("without awareness report-progress is replicated: more reports per move (IV vs II)", "IV 0.86 > II",
                 f"II {rpm['II']:.2f}, IV {rpm['IV']:.2f}", verdict(int(rpm["IV"] > rpm["II"]), 1),
-                paired_p(rows, "reports_per_move", "IV", "II")),
+                *compare(rows, "reports_per_move", "IV", "II")),
         Finding("without awareness every capable robot runs find-locations; with it, one", "III 2, IV 3; I, II 1",
                 fmt(find, 1), "yes" if exact_find else verdict(int(find["III"] > find["I"]) +
                                                                int(find["IV"] > find["II"]), 2)),
         Finding("energy: IV is the worst version", "IV worst", fmt(energy),
                 verdict(lower(energy, [(v, "IV") for v in VERSIONS if v != "IV"]), 3),
-                paired_p(rows, "energy_parker_units", "IV", costliest_rival)),
+                *compare(rows, "energy_parker_units", "IV", costliest_rival)),
         Finding("energy: III better than IV; I and II better than IV", "III, I, II < IV", fmt(energy),
                 verdict(lower(energy, energy_pairs), len(energy_pairs)),
-                max(paired_p(rows, "energy_parker_units", a, b) for a, b in energy_pairs)),
+                *findings.weakest(compare(rows, "energy_parker_units", a, b) for a, b in energy_pairs)),
         Finding("time: III (2 robots, no awareness) is the slowest", "III slowest", fmt(time),
                 verdict(lower(time, [(v, "III") for v in VERSIONS if v != "III"]), 3),
-                paired_p(rows, "mission_time_s", "III", slowest_rival)),
+                *compare(rows, "mission_time_s", "III", slowest_rival)),
         Finding("time: three robots beat two, even IV against I", "II, IV < I, III", fmt(time),
                 verdict(lower(time, time_pairs), len(time_pairs)),
-                max(paired_p(rows, "mission_time_s", a, b) for a, b in time_pairs)),
+                *findings.weakest(compare(rows, "mission_time_s", a, b) for a, b in time_pairs)),
         Finding("pucks per transport (extras in the cavity)", f"{THESIS_PUCKS_PER_TRANSPORT}", f"{ppt:.2f}",
                 verdict(int(abs(ppt - THESIS_PUCKS_PER_TRANSPORT) <= 0.3), 1)),
     ]

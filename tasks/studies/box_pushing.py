@@ -28,9 +28,10 @@ from teamsim.controllers.alliance.motivation import AllianceParams
 from teamsim.controllers.behaviours.box_pushing import BoxPushParams
 from teamsim.faults import Fault
 from teamsim.files import write_atomic, write_csv
-from teamsim.stats import paired_t_test
+from teamsim.stats import paired_t_test, ratio_ci
 from teamsim.sweep import run_trials
 from teamsim.tasks.missions.box_pushing import BoxPushingParams
+from teamsim.tasks.studies.findings import interval_text
 
 EXPERIMENTS = ("robot-failure", "heterogeneity")
 THESIS_PAUSE = (5.0, 8.0)  # s, §6.1.2: "a brief pause of about 5 to 8 seconds"
@@ -228,7 +229,8 @@ def _heterogeneity(study: BoxPushingStudy, rows: list[dict]) -> list[str]:
              f"{study.remove_window[1]:g} s; red taken away {study.with_genghis:g} s later; {n} trials.", "",
              "| what | thesis | teamsim | verdict |", "|---|---|---|---|",
              f"| red's left pushes per minute, with green / with Genghis-II | falls ('much less frequently') | "
-             f"{_mean(rows, 'red_rate_before'):.1f} / {_mean(rows, 'red_rate_after'):.1f} (x{drop:.2f}); fewer in "
+             f"{_mean(rows, 'red_rate_before'):.1f} / {_mean(rows, 'red_rate_after'):.1f} (x{drop:.2f}, 95 % CI "
+             f"{interval_text(*ratio_ci(after, before)[1:]) or '-'}); fewer in "
              f"{fewer}/{n}; paired t-test p = {p:.2g} | {'yes' if fewer == n and p < 0.05 else 'partly'} |",
              f"| pushes per minute at the right end, green (R-2) / Genghis-II | Genghis-II slower | "
              f"{_mean(rows, 'helper_rate'):.1f} / {_mean(rows, 'genghis_rate'):.1f} | "

@@ -143,7 +143,7 @@ def claims(rows: list[dict]) -> list[Finding]:
         higher = sum(a > b for a, b in zip(off, on))
         return Finding(claim, thesis, f"none {np.mean(on):.{digits}f}, radio-off {np.mean(off):.{digits}f}; higher "
                                       f"in {higher}/{len(off)} missions", verdict(int(np.mean(off) > np.mean(on)), 1),
-                       findings.paired_p(rows, key, "condition", "radio-off", "none"))
+                       *findings.compare(rows, key, "condition", "radio-off", "none"))
 
     present = [c for c in CONDITIONS if of(c)]
     complete = [c for c in present if all(r["completed"] for r in of(c))]

@@ -17,10 +17,10 @@ import numpy as np
 from teamsim.config import TrialConfig
 from teamsim.controllers.behaviours.formation import STRATEGIES
 from teamsim.files import write_atomic, write_csv
+from teamsim.plots import pyplot, save_figure
 from teamsim.sweep import run_trials
 from teamsim.tasks.missions.formation import FormationMission, FormationParams
-from teamsim.tasks.missions.formation_figures import pyplot, write_figure
-from teamsim.tasks.studies.findings import Finding, paired, paired_p, table
+from teamsim.tasks.studies.findings import Comparison, Finding, compare, paired, table
 
 COLUMNS = ("strategy", "run", "seed", "route", "crossing", "status", "completed", "mission_time_s",
            "normalised_error", "normalised_error_route", "turned_round_s", "order_broken_s", "real_time_factor")
@@ -98,12 +98,13 @@ def mean_of(rows: list[dict], strategy: str, key: str, **where) -> float:
     return float(np.mean(values)) if values else math.nan
 
 
-def change(rows: list[dict], a: str, b: str, key: str) -> tuple[float, float, int]:
-    """(b's mean over a's, in % change; paired p; pairs) of ``key`` over the runs both completed."""
+def change(rows: list[dict], a: str, b: str, key: str) -> tuple[float, Comparison, int]:
+    """(b's mean over a's, in % change; the paired comparison of b with a; pairs) of ``key`` over the runs both
+    completed."""
     first, second = paired(rows, key, "strategy", a, b)
     if not first:
-        return math.nan, math.nan, 0
-    return 100 * (np.mean(second) / np.mean(first) - 1), paired_p(rows, key, "strategy", a, b), len(first)
+        return math.nan, Comparison(math.nan, ""), 0
+    return 100 * (np.mean(second) / np.mean(first) - 1), compare(rows, key, "strategy", b, a), len(first)
 
 
 def judged(measured: float, thesis: float) -> str:
@@ -122,14 +123,14 @@ def claims(rows: list[dict], strategies: tuple[str, ...]) -> list[Finding]:
         (a, b, "normalised_error_route", figure) for a, b, key, figure in THESIS if key == "normalised_error"]
     for a, b, key, figure in readings:
         if a in strategies and b in strategies:
-            measured, p, pairs = change(rows, a, b, key)
+            measured, vs, pairs = change(rows, a, b, key)
             found.append(Finding(f"{b} vs {a}: {WHAT[key]}", f"{figure:+.0f} %", f"{measured:+.0f} % ({pairs} pairs)",
-                                 judged(measured, figure), p))
+                                 judged(measured, figure), *vs))
     if "III" in strategies and "IV" in strategies:
-        measured, p, pairs = change(rows, "III", "IV", "mission_time_s")
+        measured, vs, pairs = change(rows, "III", "IV", "mission_time_s")
         verdict = "n/a" if math.isnan(measured) else "yes" if abs(measured) < 10 else "**no**"
         found.append(Finding("IV vs III: mission time", "little gain (taken as within 10 %)",
-                             f"{measured:+.0f} % ({pairs} pairs)", verdict, p))
+                             f"{measured:+.0f} % ({pairs} pairs)", verdict, *vs))
     if "I" in strategies:
         sharp = {s: [r for r in rows if r["strategy"] == s and r["route"] == "sharp"] for s in strategies}
         broken = {s: float(np.mean([r["order_broken_s"] or 0 for r in runs])) if runs else math.nan
@@ -218,7 +219,7 @@ def plot_time_error(path: Path, rows: list[dict], strategies: tuple[str, ...]) -
     if axes.get_legend_handles_labels()[0]:
         axes.legend()
     fig.tight_layout()
-    write_figure(path, fig)
+    save_figure(fig, path)
 
 
 def plot_error_over_time(path: Path, configs: list[TrialConfig], summaries: list[dict]) -> None:
@@ -234,4 +235,4 @@ def plot_error_over_time(path: Path, configs: list[TrialConfig], summaries: list
     if axes.get_legend_handles_labels()[0]:
         axes.legend()
     fig.tight_layout()
-    write_figure(path, fig)
+    save_figure(fig, path)

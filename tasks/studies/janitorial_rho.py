@@ -12,12 +12,12 @@ import warnings
 from dataclasses import dataclass
 from pathlib import Path
 
-import cv2
 import numpy as np
 from scipy.stats import wilcoxon
 
 from teamsim.config import TrialConfig
 from teamsim.files import write_atomic, write_csv
+from teamsim.plots import pyplot, save_figure
 from teamsim.sweep import run_trials
 from teamsim.tasks.missions.janitorial import JanitorialMission, JanitorialParams
 from teamsim.tasks.studies.findings import Finding, verdict
@@ -82,7 +82,7 @@ def run_study(study: JanitorialRhoStudy) -> Path:
 
 
 def write_results(study: JanitorialRhoStudy, configs: list[TrialConfig], summaries: list[dict]) -> Path:
-    """``results.csv``, ``times.png`` and ``report.md`` in ``study.out`` from the trials' summaries."""
+    """``results.csv``, ``times.png`` (and ``.svg``) and ``report.md`` in ``study.out`` from the trials' summaries."""
     rows = [result_row(c, s) for c, s in zip(configs, summaries)]
     study.out.mkdir(parents=True, exist_ok=True)
     write_csv(study.out / "results.csv", COLUMNS, rows)
@@ -227,66 +227,38 @@ DIFFERENCES = """\
 
 
 # -- figure -------------------------------------------------------------------------------------------------------
-LEFT, RIGHT, TOP, BOTTOM = 60, 20, 40, 70  # px around the plot
-BLACK, GREY, BLUE, RED = (0, 0, 0), (120, 120, 120), (180, 119, 31), (40, 39, 214)  # BGR
-FONT = cv2.FONT_HERSHEY_SIMPLEX
-
-
-def nice_step(span: float) -> float:
-    """The smallest 1, 2, 2.5 or 5 x 10^k at least ``span``."""
-    power = 10.0 ** math.floor(math.log10(span))
-    return next(m * power for m in (1.0, 2.0, 2.5, 5.0, 10.0) if m * power >= span)
-
-
-def plot_times(path: Path, rows: list[dict], rhos: list[float], duration: float, width: int = 900,
-               height: int = 420) -> None:
+def plot_times(path: Path, rows: list[dict], rhos: list[float], duration: float) -> None:
     """Fig. 6-13's form: each run's mission time at each rate, the mean of the completed runs marked; a run that
-    did not complete is drawn hollow at the duration, where its time is censored (an errored run is not drawn)."""
+    did not complete is drawn hollow at the duration, where its time is censored (an errored run is not drawn).
+    Written as ``path`` (PNG) and the same stem ``.svg``."""
+    fig, axes = pyplot().subplots(figsize=(8.2, 3.8))
     finished = [r["mission_time_s"] for r in rows if r["completed"] and r["mission_time_s"] is not None]
     censored = any(r["status"] == "failed" for r in rows)
-    top = 1.05 * max([*finished, *([duration] if censored or not finished else [])])
-    tick = nice_step(top / 5)
-    ticks = math.ceil(top / tick)
-    image = np.full((height, width, 3), 255, np.uint8)
-
-    def y_of(value: float) -> int:
-        return int(TOP + (height - TOP - BOTTOM) * (1 - value / (ticks * tick)))
-
-    def text(words: str, at: tuple[int, int], scale: float = 0.4, colour=BLACK) -> None:
-        cv2.putText(image, words, at, FONT, scale, colour, 1, cv2.LINE_AA)
-
-    text("Mission time per rate rho (Parker Fig. 6-13)", (LEFT, 26), 0.6)
-    for k in range(ticks + 1):
-        cv2.line(image, (LEFT, y_of(k * tick)), (width - RIGHT, y_of(k * tick)), (225, 225, 225), 1)
-        text(f"{k * tick:g}", (8, y_of(k * tick) + 4))
-    text("time (s)", (8, TOP - 12))
     if censored:
-        cv2.line(image, (LEFT, y_of(duration)), (width - RIGHT, y_of(duration)), GREY, 1, cv2.LINE_AA)
-        text(f"duration {duration:g} s", (LEFT + 4, y_of(duration) - 8), colour=GREY)
-    column = (width - LEFT - RIGHT) / max(len(rhos), 1)
+        axes.axhline(duration, color="0.47", lw=1)
+        axes.annotate(f"duration {duration:g} s", (0, duration), xycoords=("axes fraction", "data"),
+                      xytext=(4, 4), textcoords="offset points", color="0.47", fontsize=8)
     for c, rho in enumerate(rhos):
-        centre = LEFT + column * (c + 0.5)
         runs = sorted(at(rows, rho), key=lambda r: r["seed"])
-        for k, r in enumerate(runs):
-            x = int(centre + column * 0.5 * ((k + 0.5) / len(runs) - 0.5))  # the runs spread across the column
-            if r["completed"] and r["mission_time_s"] is not None:
-                cv2.circle(image, (x, y_of(r["mission_time_s"])), 4, BLUE, -1, cv2.LINE_AA)
-            elif r["status"] == "failed":
-                cv2.circle(image, (x, y_of(duration)), 4, RED, 1, cv2.LINE_AA)
+        spread = [c + 0.5 * ((k + 0.5) / len(runs) - 0.5) for k in range(len(runs))]  # the runs across the column
+        done = [(x, r["mission_time_s"]) for x, r in zip(spread, runs) if r["completed"]
+                and r["mission_time_s"] is not None]
+        failed = [x for x, r in zip(spread, runs) if r["status"] == "failed"]
+        axes.plot([x for x, _ in done], [t for _, t in done], "o", color="C0", ms=6,
+                  label="completed run" if c == 0 else None)
+        axes.plot(failed, [duration] * len(failed), "o", mfc="none", color="C3", ms=6,
+                  label="not completed (censored at the duration)" if c == 0 else None)
         mean = mean_sd(times(rows, rho).values())[0]
-        if not math.isnan(mean):
-            half = int(column * 0.35)
-            cv2.line(image, (int(centre) - half, y_of(mean)), (int(centre) + half, y_of(mean)), BLACK, 2, cv2.LINE_AA)
-        text(f"rho = {rho:g}", (int(centre) - 30, height - BOTTOM + 18), 0.45)
-        text(f"{len(times(rows, rho))}/{len(runs)} completed", (int(centre) - 45, height - BOTTOM + 36), colour=GREY)
-    cv2.line(image, (LEFT, y_of(0)), (width - RIGHT, y_of(0)), BLACK, 1)
-    legend = height - 12
-    cv2.circle(image, (LEFT + 6, legend - 4), 4, BLUE, -1, cv2.LINE_AA)
-    text("completed run", (LEFT + 16, legend))
-    cv2.circle(image, (LEFT + 156, legend - 4), 4, RED, 1, cv2.LINE_AA)
-    text("not completed (censored at the duration)", (LEFT + 166, legend))
-    cv2.line(image, (LEFT + 486, legend - 4), (LEFT + 506, legend - 4), BLACK, 2)
-    text("mean of the completed runs", (LEFT + 514, legend))
-    ok, png = cv2.imencode(".png", image)
-    if ok:
-        write_atomic(path, png.tobytes())
+        axes.hlines(mean, c - 0.35, c + 0.35, color="black", lw=2,
+                    label="mean of the completed runs" if c == 0 else None)
+    axes.set_xticks(range(len(rhos)), [f"rho = {rho:g}\n{len(times(rows, rho))}/{len(at(rows, rho))} completed"
+                                       for rho in rhos])
+    top = 1.08 * max([*finished, *([duration] if censored or not finished else [])])
+    axes.set(xlim=(-0.5, len(rhos) - 0.5), ylim=(0, top), ylabel="time (s)")
+    axes.set_title("Mission time per rate rho (Parker Fig. 6-13)", loc="left")
+    axes.grid(axis="y", color="0.88")
+    axes.set_axisbelow(True)
+    axes.spines[["top", "right"]].set_visible(False)
+    axes.legend(loc="upper left", bbox_to_anchor=(0, -0.2), ncol=3, frameon=False, fontsize=8)
+    fig.tight_layout()
+    save_figure(fig, path)

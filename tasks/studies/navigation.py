@@ -28,10 +28,11 @@ import numpy as np
 from teamsim.config import TrialConfig
 from teamsim.files import write_atomic, write_csv
 from teamsim.plots import grouped_bars
-from teamsim.stats import paired_t_test
+from teamsim.stats import paired_t_test, ratio_ci
 from teamsim.sweep import default_workers, run_trials
 from teamsim.tasks.missions.navigate import (TABLE_3_1, THESIS_METHODS, WORLD_FAMILIES, NavigateParams,
                                             kinematic_trial, time_limit)
+from teamsim.tasks.studies.findings import interval_text
 
 COLUMNS = ("robot", "density", "controller", "trial", "seed", "world_seed", "success", "nav_time", "path_index",
            "avg_velocity", "path_length", "planned_length", "touches", "failure", "loop_period", "loop_diameter",
@@ -147,7 +148,8 @@ def cells_of(rows: list[dict]) -> dict[tuple, Cell]:
 
 
 def compare(cells: dict, robot: str, density: float, controller: str) -> dict:
-    """Paired comparison of ``controller`` with FRC on the same worlds: OS and NT ratios and p-values."""
+    """Paired comparison of ``controller`` with FRC on the same worlds: OS and NT ratios with their 95 % confidence
+    intervals (low, high) and p-values."""
     ours = {r["trial"]: r for r in cells[(robot, density, controller)].rows}
     frc = {r["trial"]: r for r in cells[(robot, density, "FRC")].rows}
     trials = sorted(set(ours) & set(frc))
@@ -155,9 +157,9 @@ def compare(cells: dict, robot: str, density: float, controller: str) -> dict:
     both = [t for t in trials if ours[t]["success"] and frc[t]["success"]]
     nt_a, nt_b = [ours[t]["nav_time"] for t in both], [frc[t]["nav_time"] for t in both]
     return {"os_ratio": float(np.mean(os_a) / np.mean(os_b)) if np.mean(os_b) > 0 else math.nan,
-            "os_p": paired_t_test(os_a, os_b)[1],
+            "os_ci": ratio_ci(os_a, os_b)[1:], "os_p": paired_t_test(os_a, os_b)[1],
             "nt_ratio": float(np.mean(nt_a) / np.mean(nt_b)) if both else math.nan,
-            "nt_p": paired_t_test(nt_a, nt_b)[1] if both else math.nan}
+            "nt_ci": ratio_ci(nt_a, nt_b)[1:], "nt_p": paired_t_test(nt_a, nt_b)[1] if both else math.nan}
 
 
 def run_study(study: NavigationStudy) -> Path:
@@ -398,18 +400,21 @@ def write_report(study: NavigationStudy, rows: list[dict], wall_s: float | None 
         lines += [f"- **{'; '.join(claims)}**: {cause}" for cause, claims in causes.items()]
     lines += ["", "![overall score](os.png)", "", "## Cells", "",
               "NT, PI and AV are means over successful trials; ratios and p-values are against FRC on the same "
-              "worlds (paired two-sided t-test). Failures over their last 200 s (`tasks/missions/looping.py`): "
+              "worlds (paired two-sided t-test), each ratio of means with its 95 % confidence interval (Fieller's, "
+              "paired). Failures over their last 200 s (`tasks/missions/looping.py`): "
               "stalled (mean speed under 10 % of v_max), looping (kept coming back to where it was: median period "
               "and largest extent, medians over the cell's loops) or wandered.", "",
-              "| robot | density | controller | NT (s) | PI | SR | AV | OS | OS/FRC | p | NT/FRC | p | failures | "
-              "thesis (Figs 3.10-3.15) |",
+              "| robot | density | controller | NT (s) | PI | SR | AV | OS | OS/FRC [95 % CI] | p | NT/FRC [95 % CI] | "
+              "p | failures | thesis (Figs 3.10-3.15) |",
               "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for (robot, density, controller), cell in sorted(cells.items()):
         vs = compare(cells, robot, density, controller) if controller != "FRC" and (robot, density, "FRC") in cells \
-            else {"os_ratio": math.nan, "os_p": math.nan, "nt_ratio": math.nan, "nt_p": math.nan}
+            else {"os_ratio": math.nan, "os_ci": (math.nan,) * 2, "os_p": math.nan, "nt_ratio": math.nan,
+                  "nt_ci": (math.nan,) * 2, "nt_p": math.nan}
         lines.append(f"| {robot} | {density:.0%} | {controller} | {cell.mean('nav_time'):.1f} | "
                      f"{cell.mean('path_index'):.2f} | {cell.sr:.0%} | {cell.mean('avg_velocity'):.2f} | "
-                     f"{cell.os:.2f} | {vs['os_ratio']:.2f} | {vs['os_p']:.3f} | {vs['nt_ratio']:.2f} | "
+                     f"{cell.os:.2f} | {_ratio(vs['os_ratio'], vs['os_ci'])} | {vs['os_p']:.3f} | "
+                     f"{_ratio(vs['nt_ratio'], vs['nt_ci'])} | "
                      f"{vs['nt_p']:.3f} | {failure_kinds(cell)} | "
                      f"{THESIS_FIGURES.get((controller.removesuffix('-printed'), robot), '')} |")
     failures = [r for r in rows if r["status"] not in ("completed", "failed")]
@@ -421,6 +426,11 @@ def write_report(study: NavigationStudy, rows: list[dict], wall_s: float | None 
                   for d in study.densities] for c in study.controllers}
     grouped_bars(study.out / "os.png", "Overall score OS = (SR + PI + AV) / 3 per robot and density", groups,
                  series, "OS", y_max=1.0)
+
+
+def _ratio(ratio: float, interval: tuple[float, float]) -> str:
+    """A ratio with its confidence interval beside it, when it has one."""
+    return " ".join(filter(None, (f"{ratio:.2f}", interval_text(*interval))))
 
 
 def study_from_args(**kwargs) -> NavigationStudy:

@@ -9,8 +9,8 @@ import os
 import sys
 from pathlib import Path
 
-from teamsim.config import ConfigError, TrialConfig, apply_setting, validate
-from teamsim.faults import FAULT_KINDS, SPEC_FORM, parse_fault
+from teamsim.config import ConfigError, TrialConfig, VideoConfig
+from teamsim.faults import FAULT_KINDS, SPEC_FORM
 from teamsim.gl import RenderBackendError
 
 # teamsim.tasks.studies.cleanup_faults.CONDITIONS, spelled out so that building the parser imports no physics
@@ -39,9 +39,17 @@ def _build_parser() -> argparse.ArgumentParser:
     run = commands.add_parser("run", help="run one trial of a mission")
     _trial_arguments(run)
     run.add_argument("--video", action="store_true", help="write video.mp4 (H.264)")
-    run.add_argument("--camera", default="top", help="'top' or a robot name for its tracking camera")
+    run.add_argument("--video-size", metavar="WxH", help="video frame size in pixels (default: 640x480; even sides, "
+                                                         "width 64-3840, height 48-2160)")
+    run.add_argument("--camera", default="top", help="'top', 'perspective' (the whole arena from 50 degrees up) or a "
+                                                     "robot name for its tracking camera")
     run.add_argument("--out", default="renders", help="output root (default: renders)")
     run.add_argument("--run-id", help="run folder name (default: seed and timestamp)")
+
+    view = commands.add_parser("view", help="watch a mission live in MuJoCo's interactive viewer (needs a display)")
+    _trial_arguments(view)
+    view.add_argument("--speed", type=float, default=1.0, help="simulated seconds per second (default: 1, real time)")
+    view.set_defaults(video=False, camera="top", out="renders", run_id=None)
 
     scenario = commands.add_parser("scenario", help="scenario files: a world, a team and its faults in one YAML "
                                                     "file (docs/scenarios.md)")
@@ -56,10 +64,10 @@ def _build_parser() -> argparse.ArgumentParser:
     render.add_argument("run_dirs", type=Path, nargs="+", metavar="RUN_DIR")
     render.add_argument("--workers", type=_positive_int("--workers"), help="runs rendered at once (default: one "
                                                                           "per core)")
-    render.add_argument("--camera", default="top")
+    render.add_argument("--camera", default="top", help="'top', 'perspective' or a robot name, as for run")
     render.add_argument("--out", type=Path, help="video path, with one RUN_DIR (default: RUN_DIR/video-CAMERA.mp4)")
-    render.add_argument("--width", type=int, default=640)
-    render.add_argument("--height", type=int, default=480)
+    render.add_argument("--video-size", metavar="WxH", default="640x480", help="frame size in pixels, as for run "
+                                                                               "(default: 640x480)")
 
     export = commands.add_parser("export", help="standalone MJCF of one robot on a floor")
     export.add_argument("robot")
@@ -258,22 +266,13 @@ def cmd_study(args) -> int:
 
 
 def _trial_config(args) -> TrialConfig:
-    from teamsim.runner import mission_of
-    from teamsim.scenario import supports
-    from teamsim.cli.scenario import scenario_config
+    from teamsim.runner import trial_config
 
-    mission = mission_of(args.mission)
-    config = TrialConfig(mission=args.mission, params=mission.Params(), seed=args.seed or 0, duration=args.duration,
-                         out=args.out, run_id=args.run_id)
-    config.video.enabled = args.video
-    config.video.camera = args.camera
-    if args.scenario or supports(mission):
-        return scenario_config(args, mission, config)
-    for assignment in args.set:
-        apply_setting(config, assignment)
-    config.faults = [parse_fault(spec) for spec in args.fault]
-    validate(config)
-    return config
+    video = VideoConfig(enabled=args.video, camera=args.camera)
+    if getattr(args, "video_size", None) is not None:
+        video.width, video.height = video.parse_size(args.video_size)
+    return trial_config(args.mission, scenario=args.scenario, seed=args.seed, duration=args.duration,
+                        settings=args.set, faults=args.fault, out=args.out, run_id=args.run_id, video=video)
 
 
 def cmd_scenario(args) -> int:
@@ -297,6 +296,15 @@ def cmd_run(args) -> int:
     if s.get("error"):
         print(f"  {s['error']}", file=sys.stderr)
     return {"completed": 0, "interrupted": 130}.get(result.status, 1)
+
+
+def cmd_view(args) -> int:
+    from teamsim.runner import mission_of
+    from teamsim.viewer import view
+
+    result = view(_trial_config(args), mission_of(args.mission), speed=args.speed)
+    print(f"{result.status}: {result.sim_time_s:.1f} s simulated in {result.wall_time_s:.1f} s")
+    return 0 if result.status in ("completed", "closed") else 1
 
 
 def cmd_list(_args) -> int:
@@ -334,14 +342,16 @@ def cmd_list(_args) -> int:
 
 
 def cmd_render(args) -> int:
+    from teamsim.config import VideoConfig
     from teamsim.rerender import rerender, rerender_all
 
+    width, height = VideoConfig.parse_size(args.video_size)
     if args.out is not None and len(args.run_dirs) > 1:
         raise UsageError(f"--out names one video; got {len(args.run_dirs)} RUN_DIRs (leave --out out)")
     if args.out is not None:
-        outs = [rerender(args.run_dirs[0], args.camera, args.out, args.width, args.height)]
+        outs = [rerender(args.run_dirs[0], args.camera, args.out, width, height)]
     else:
-        outs = rerender_all(args.run_dirs, args.camera, args.width, args.height, args.workers)
+        outs = rerender_all(args.run_dirs, args.camera, width, height, args.workers)
     for out in outs:
         print(f"wrote {out}")
     return 0
@@ -405,7 +415,7 @@ def main(argv: list[str] | None = None) -> int:
         args = parser.parse_args(argv)
         return {"run": cmd_run, "list": cmd_list, "render": cmd_render, "export": cmd_export,
                 "bench": cmd_bench, "study": cmd_study, "allocate": cmd_allocate,
-                "scenario": cmd_scenario}[args.command](args)
+                "scenario": cmd_scenario, "view": cmd_view}[args.command](args)
     except (UsageError, ConfigError, RenderBackendError) as exc:
         print(f"teamsim: error: {exc}", file=sys.stderr)
         return EXIT_USAGE

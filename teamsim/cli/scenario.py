@@ -19,47 +19,8 @@ from pathlib import Path
 
 import yaml
 
-from teamsim.config import ConfigError, TrialConfig, apply_setting, settable_keys, validate
-from teamsim.faults import parse_fault
-from teamsim.scenario import (Scenario, config_of, dump, generate, load, not_supported, read, scenario_of,
-                              set_path, supports, to_data)
-
-SCENARIO_FIELDS = tuple(f.name for f in dataclasses.fields(Scenario))
-
-
-def _key(assignment: str) -> str:
-    return assignment.partition("=")[0].strip()
-
-
-def scenario_config(args, mission, like: TrialConfig) -> TrialConfig:
-    """The trial configuration a run of ``args`` uses, for a mission that supports scenarios. ``like`` holds
-    the run's other settings (mission parameters, output folder, video), as the command line gave them."""
-    if not supports(mission):
-        raise not_supported(mission)
-    faults = [parse_fault(spec) for spec in args.fault]
-    legacy = set(settable_keys(like)) if not args.scenario else set()
-    paths = []
-    for assignment in args.set:
-        key = _key(assignment)
-        bare_unknown = not args.scenario and key.isidentifier() and key not in SCENARIO_FIELDS
-        if key.startswith("video.") or key in legacy or bare_unknown:
-            apply_setting(like, assignment)  # (a bare unknown key gets its error listing the settable keys)
-        else:
-            paths.append(assignment)
-    validate(like)
-    if args.scenario:
-        data, base = read(args.scenario), Path(args.scenario).parent
-        for name, value in (("seed", args.seed), ("duration", args.duration)):
-            if value is not None:
-                if not isinstance(data, dict):
-                    raise ConfigError(f"{args.scenario}: expected a mapping of scenario fields")
-                data[name] = value
-        like = dataclasses.replace(like, params=None)  # the file, not the mission's parameters, is the world
-    else:
-        data, base = to_data(generate(dataclasses.replace(like, faults=faults), mission)), None
-    for assignment in paths:
-        data = set_path(data, assignment)
-    return config_of(load(data, mission, base), mission, like, faults)
+from teamsim.config import ConfigError, TrialConfig
+from teamsim.scenario import Scenario, dump, scenario_of, supports, to_data
 
 
 def show(args, mission, config: TrialConfig) -> int:

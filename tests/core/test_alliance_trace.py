@@ -5,7 +5,6 @@ from __future__ import annotations
 import json
 from types import SimpleNamespace
 
-import cv2
 import numpy as np
 import pytest
 
@@ -21,7 +20,6 @@ from teamsim.runner import run_trial
 from teamsim.scene import RobotSlot
 from teamsim.tasks import MISSIONS
 from teamsim.tasks.missions.custom import CustomMission, CustomParams, custom_config
-from teamsim.timeline import ROW, SET_ROW, draw_timeline
 
 RADIO = RadioConfig(rate_hz=2.0)  # tau = 1.5 s
 # red is keen to patrol; green would patrol too but rests first, and gives rest up after lambda = 3 s.
@@ -104,11 +102,10 @@ def test_trace_events_timeline_and_takeover_after_a_kill(tmp_path, monkeypatch):
     assert active[-1] == 0 and levels[:, 1].max() > 1.0  # patrolling at the end; rest crossed theta before
     assert trajectory["motivation/red/time"][-1] <= KILL
 
-    # timeline.png: one row per behaviour set for both robots (and a marker legend), instead of one row each.
-    png = cv2.imread(str(result.run_dir / "timeline.png"))
-    names = [str(n) for n in trajectory["robot_names"]]
-    plain = draw_timeline(trajectory["time"], trajectory["behaviour"], names, [])
-    assert png.shape[0] == plain.shape[0] + 2 * (2 * SET_ROW - ROW) + 22
+    # timeline.png and .svg: one row per behaviour set for both robots, each with its m(t) drawn.
+    svg = (result.run_dir / "timeline.svg").read_text()
+    assert all(f'id="motivation/{robot}/{name}"' in svg for robot in ("red", "green") for name in ("patrol", "rest"))
+    assert 'id="acquiescence/green"' in svg and (result.run_dir / "timeline.png").stat().st_size > 0
 
 
 def test_same_seed_same_trace_and_lalliance_is_traced_too(tmp_path, monkeypatch):

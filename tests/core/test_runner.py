@@ -33,7 +33,7 @@ def test_outputs_written(tmp_path):
     run_dir = tmp_path / "wander" / "run"
     assert result.run_dir == run_dir and result.status == "completed"
     assert sorted(p.name for p in run_dir.iterdir()) == ["events.jsonl", "summary.json", "timeline.png",
-                                                             "trajectory.npz"]
+                                                             "timeline.svg", "trajectory.npz"]
     summary = json.loads((run_dir / "summary.json").read_text())
     assert summary["completed"] is True and summary["sim_time_s"] == pytest.approx(6.0)
     assert set(summary["robots"]) == {"red", "green", "blue", "yellow"}
@@ -63,14 +63,14 @@ def test_same_seed_same_results(tmp_path):
 
 
 def test_python_exception_ends_in_error_with_outputs(tmp_path, monkeypatch):
-    original = World._control
+    original = World.act
 
-    def failing(self, robot, now, *args):
-        if now >= 1.0:
+    def failing(self, robot, observation, command):
+        if observation.time >= 1.0:
             raise RuntimeError("controller exploded")
-        original(self, robot, now, *args)
+        original(self, robot, observation, command)
 
-    monkeypatch.setattr(World, "_control", failing)
+    monkeypatch.setattr(World, "act", failing)
     result = run_trial(quick_config(tmp_path))
     assert result.status == "error"
     summary = json.loads((result.run_dir / "summary.json").read_text())

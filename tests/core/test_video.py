@@ -29,7 +29,7 @@ def test_live_video_and_rerender_match(tmp_path, capsys):
     # Robots move: the first and last frames differ by more than the HUD's clock.
     assert np.mean(np.any(live[0] != live[-1], axis=2)) > 0.005
 
-    assert main(["render", str(result.run_dir), "--width", "320", "--height", "240",
+    assert main(["render", str(result.run_dir), "--video-size", "320x240",
                  "--out", str(tmp_path / "again.mp4")]) == 0
     _, again = decode(tmp_path / "again.mp4")
     assert len(again) == len(live)
@@ -41,8 +41,8 @@ def test_live_video_and_rerender_match(tmp_path, capsys):
 def test_tracking_camera_rerender(tmp_path):
     cfg = wander_config(tmp_path, params={"robots": 2}, seed=2, duration=1.0, run_id="t")
     run_trial(cfg)  # no video while running: the trajectory alone is enough to render later
-    assert main(["render", str(tmp_path / "wander" / "t"), "--camera", "green", "--width", "160",
-                 "--height", "120"]) == 0
+    assert main(["render", str(tmp_path / "wander" / "t"), "--camera", "green", "--video-size",
+                 "160x120"]) == 0
     meta, frames = decode(tmp_path / "wander" / "t" / "video-green-track.mp4")
     assert meta["size"] == (160, 120) and len(frames) == 31
 
@@ -63,9 +63,8 @@ def test_several_runs_render_in_parallel_as_each_alone(tmp_path, capsys):
     for seed in (3, 4):
         run_trial(wander_config(tmp_path, params={"robots": 2}, seed=seed, duration=1.0, run_id=f"r{seed}"))
         runs.append(tmp_path / "wander" / f"r{seed}")
-    assert main(["render", *map(str, runs), "--width", "160", "--height", "120", "--workers", "2"]) == 0
-    assert main(["render", str(runs[1]), "--width", "160", "--height", "120",
-                 "--out", str(tmp_path / "alone.mp4")]) == 0
+    assert main(["render", *map(str, runs), "--video-size", "160x120", "--workers", "2"]) == 0
+    assert main(["render", str(runs[1]), "--video-size", "160x120", "--out", str(tmp_path / "alone.mp4")]) == 0
     _, parallel = decode(runs[1] / "video-top.mp4")
     _, alone = decode(tmp_path / "alone.mp4")
     assert len(parallel) == len(alone) == 31

@@ -138,4 +138,4 @@ def test_physics_runs_the_same_controllers_and_maps(tmp_path):
     assert result.status in ("completed", "failed") and result.summary["error"] is None
     assert len(events({"metrics": metrics}, "assigned")) >= 2
     assert metrics["explored_share"] > 0.15 and metrics["map_accuracy"] >= 0.9
-    assert (result.run_dir / "map.png").exists() and (result.run_dir / "coverage.png").exists()
+    assert all((result.run_dir / f"{name}.{kind}").exists() for name in ("map", "coverage") for kind in ("png", "svg"))

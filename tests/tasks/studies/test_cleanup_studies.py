@@ -124,6 +124,9 @@ def test_fault_report_gives_the_theses_findings_with_verdicts_and_p(tmp_path):
     found = {f.claim.split(" (")[0].split(":")[0]: f for f in cf.claims(rows)}
     reports = found["without awareness report-progress is repeated"]
     assert reports.verdict == "yes" and "higher in 2/2" in reports.teamsim and reports.p < 0.2
+    # radio-off's mean over the radio's, 0.5 / (1/7), with t(0.975, 1) = 12.706 times its standard error (none's
+    # reports per move are the same in both missions, so the interval is the mean's, scaled).
+    assert reports.ratio == "radio-off/none 3.50 [-2.85, 9.85]"
     energy = found["awareness saves energy"]
     assert energy.verdict == "**no**" and "higher in 1/2" in energy.teamsim
     assert found["red killed during its search"].verdict == "partly"
@@ -131,6 +134,9 @@ def test_fault_report_gives_the_theses_findings_with_verdicts_and_p(tmp_path):
     text = cf.report(cf.CleanupFaultStudy(missions=2, conditions=("none", "kill-red", "radio-off"), out=tmp_path),
                      rows)
     assert "## Findings against the thesis" in text and "| yes |" in text
+    assert "| claim | thesis | teamsim | ratio [95 % CI] | p | reproduced |" in text
+    assert "| radio-off/none 3.50 [-2.85, 9.85] | 0.13 | yes, not decided by this sample |" in text
+    assert "| radio-off/none 0.91 [unbounded] | 0.7 | **no** |" in text
 
 
 def test_fault_results_read_back_as_written(tmp_path):

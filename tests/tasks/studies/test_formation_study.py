@@ -33,8 +33,11 @@ def rows_of(errors: dict[str, list[float]], broken: dict[str, int]) -> list[dict
 def test_changes_are_paired_by_seed_and_the_broken_line_is_judged_on_sharp_routes():
     rows = rows_of({"I": [2.0, 2.2, 1.8], "II": [1.7, 1.9, 1.5], "III": [1.6, 1.7, 1.4], "IV": [1.4, 1.5, 1.2]},
                    {"I": 30, "II": 2, "III": 1, "IV": 0})
-    measured, p, pairs = change(rows, "I", "II", "normalised_error")
-    assert measured == pytest.approx(-15.0) and pairs == 3 and p < 0.05
+    measured, vs, pairs = change(rows, "I", "II", "normalised_error")
+    assert measured == pytest.approx(-15.0) and pairs == 3 and vs.p < 0.05
+    # II is I less 0.3 in every run: Fieller's interval of II/I is (mean(I) - 0.3 -+ 0) / mean(I) scaled by I's
+    # spread, and lies below 1 as the p says.
+    assert vs.ratio.startswith("II/I 0.85 [") and float(vs.ratio.split(", ")[1].rstrip("]")) < 1
     found = {f.claim: f for f in claims(rows, ("I", "II", "III", "IV"))}
     assert found["II vs I: normalised error"].verdict == "yes"
     assert found["II vs I: normalised error, route reading"].verdict == "yes"
@@ -50,7 +53,8 @@ def test_a_small_study_writes_its_report_table_and_figures(tmp_path, capsys):
     assert [r["strategy"] for r in rows] == ["I", "IV"] and all(r["status"] == "failed" for r in rows)  # 15 s: short
     report = (out / "report.md").read_text()
     assert "| IV vs I: normalised error | -32 % |" in report
-    assert (out / "fig7-2.png").stat().st_size > 0 and (out / "error-over-time.png").stat().st_size > 0
+    assert all((out / f"{name}.{kind}").stat().st_size > 0 for name in ("fig7-2", "error-over-time")
+               for kind in ("png", "svg"))
 
 
 def test_bad_strategy_list_is_one_line_and_exit_2(capsys):

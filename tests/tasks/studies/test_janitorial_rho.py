@@ -48,7 +48,7 @@ def fake_study(tmp_path, time_of) -> tuple[jr.JanitorialRhoStudy, str, list[dict
     out = jr.write_results(study, configs, summaries)
     with open(out / "results.csv", newline="") as handle:
         rows = list(csv.DictReader(handle))
-    assert (out / "times.png").stat().st_size > 1000
+    assert (out / "times.png").stat().st_size > 1000 and (out / "times.svg").stat().st_size > 1000
     return study, (out / "report.md").read_text(), rows
 
 

@@ -59,7 +59,7 @@ def test_report_lists_the_causes(tmp_path):
     assert "**FRC success rate of robot A**" in report
     assert CAUSES["success"].format(**sample_notes(4)) in report and "With 4 trials a cell" in report
     assert "| A | 20% | FRC |" in report and "0 stalled" not in report
-    assert (tmp_path / "os.png").stat().st_size > 0
+    assert (tmp_path / "os.png").stat().st_size > 0 and (tmp_path / "os.svg").stat().st_size > 0
 
 
 def test_what_one_trial_weighs_follows_the_sample_size():

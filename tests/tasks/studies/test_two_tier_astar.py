@@ -120,7 +120,8 @@ def test_tiny_study_end_to_end(tmp_path):
     assert all(r["reached"] == "True" for r in rows)
     report = written["report"].read_text()
     assert "## Orderings against the thesis" in report and "| 78 KB | 25% | monolithic (Inf) |" in report
-    assert (tmp_path / "overall_time.png").stat().st_size > 0 and (tmp_path / "planning_time.png").stat().st_size > 0
+    assert all((tmp_path / f"{name}.{kind}").stat().st_size > 0 for name in ("overall_time", "planning_time")
+               for kind in ("png", "svg"))
     again = run_study(study, tmp_path / "again", workers=1)
     with open(again["results"]) as handle:
         repeat = list(csv.DictReader(handle))
