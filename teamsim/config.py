@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import types
 import typing
 from dataclasses import dataclass, field
 from typing import Any
@@ -119,7 +120,12 @@ class TrialConfig:
 
 
 def check_value(name: str, value: Any, meta: dict) -> None:
-    """Check one value against a field's bounds and choices (ConfigError naming ``name``)."""
+    """Check one value against a field's bounds and choices (ConfigError naming ``name``); a tuple of numbers (a
+    range such as ``(5.0, 7.0)``) item by item."""
+    if isinstance(value, tuple) and not meta.get("choices"):
+        for k, item in enumerate(value):
+            check_value(f"{name}[{k}]", item, meta)
+        return
     if meta.get("choices") and value not in meta["choices"]:
         raise ConfigError(f"{name}={value!r}: allowed values are {', '.join(map(str, meta['choices']))}")
     if isinstance(value, bool) or not isinstance(value, (int, float)):
@@ -149,13 +155,24 @@ def validate(obj: Any, prefix: str = "") -> None:
         post()
 
 
-def _parse_scalar(name: str, text: str, kind: Any) -> Any:
-    """Parse ``text`` as ``kind`` (bool, int, float, str or Optional of one of those)."""
-    args = [a for a in typing.get_args(kind) if a is not type(None)]
-    if args:  # Optional[X]
+def _parse_scalar(name: str, text: str, kind: Any, example: str = "") -> Any:
+    """Parse ``text`` as ``kind``: bool, int, float, str, a tuple of those (``5,7`` or ``[5, 7]``; ``example`` shows
+    one in the error), or Optional of one of those."""
+    if typing.get_origin(kind) in (typing.Union, types.UnionType):  # Optional[X]
         if text.lower() in ("none", "null", ""):
             return None
-        kind = args[0]
+        kind = next(a for a in typing.get_args(kind) if a is not type(None))
+    if typing.get_origin(kind) is tuple:
+        args = typing.get_args(kind)
+        items = text.removeprefix("[").removesuffix("]").split(",")
+        expected = (f"expected {len(args)} values separated by commas, each {_EXPECTED.get(args[0], 'text')}"
+                    + (f", e.g. {example}" if example else ""))
+        if len(items) != len(args) or Ellipsis in args:
+            raise ConfigError(f"--set {name}={text}: {expected}")
+        try:
+            return tuple(_parse_scalar(name, item.strip(), arg) for item, arg in zip(items, args))
+        except ConfigError:
+            raise ConfigError(f"--set {name}={text}: {expected}") from None
     try:
         if kind is bool:
             lowered = text.lower()
@@ -169,9 +186,11 @@ def _parse_scalar(name: str, text: str, kind: Any) -> Any:
         if kind is float:
             return float(text)
     except ValueError:
-        expected = {bool: "true or false", int: "an integer", float: "a number"}[kind]
-        raise ConfigError(f"--set {name}={text}: expected {expected}") from None
+        raise ConfigError(f"--set {name}={text}: expected {_EXPECTED[kind]}") from None
     return text
+
+
+_EXPECTED = {bool: "true or false", int: "an integer", float: "a number"}
 
 
 def settable_keys(cfg: TrialConfig) -> list[str]:
@@ -195,6 +214,11 @@ def apply_setting(cfg: TrialConfig, assignment: str) -> None:
         raise ConfigError(f"--set {key}: unknown key for mission {cfg.mission!r}; "
                           f"allowed: {', '.join(settable_keys(cfg))}")
     kind = typing.get_type_hints(type(target))[leaf]
-    value = _parse_scalar(key, text.strip(), kind)
+    if dataclasses.is_dataclass(kind):  # (a mission's group of behaviour constants: its robots' controller settings)
+        raise ConfigError(f"--set {key}: a group of settings, not one value; allowed: each of its fields by its "
+                          f"scenario path (`teamsim scenario show {cfg.mission}` lists them)")
+    default = fields[leaf].default
+    example = ",".join(map(str, default)) if isinstance(default, tuple) else ""
+    value = _parse_scalar(key, text.strip(), kind, example)
     check_value(key, value, fields[leaf].metadata)
     setattr(target, leaf, value)

@@ -2,6 +2,7 @@
 bytes, JSON (non-finite floats as strings, numpy values as plain ones) and CSV tables."""
 from __future__ import annotations
 
+import contextlib
 import csv
 import io
 import json
@@ -34,12 +35,21 @@ def to_json(value: Any, **kwargs) -> str:
 
 
 def write_atomic(path: Path, data: bytes) -> None:
+    """Write ``path`` whole or not at all; a failed write (a full disk) leaves the old file, and no temporary one. Its
+    OSError names ``path`` when the system did not name a file (a write to a full disk)."""
     tmp = path.with_name(path.name + ".tmp")
-    with open(tmp, "wb") as handle:
-        handle.write(data)
-        handle.flush()
-        os.fsync(handle.fileno())
-    os.replace(tmp, path)
+    try:
+        with open(tmp, "wb") as handle:
+            handle.write(data)
+            handle.flush()
+            os.fsync(handle.fileno())
+        os.replace(tmp, path)
+    except BaseException as exc:
+        with contextlib.suppress(OSError):
+            tmp.unlink()
+        if isinstance(exc, OSError) and exc.filename is None:
+            exc.filename = str(path)
+        raise
 
 
 def write_csv(path: Path, columns: Sequence[str], rows: Iterable[dict], float_format: str | None = None) -> None:

@@ -15,7 +15,11 @@ from teamsim.sweep import worker_pool
 
 def trajectory_of(run_dir: Path) -> Path:
     path = Path(run_dir) / "trajectory.npz"
-    if not path.is_file():
+    try:
+        found = path.is_file()
+    except OSError as exc:  # (a name too long: is_file lets that through)
+        raise ConfigError(f"RUN_DIR {run_dir}: cannot read ({exc.strerror or exc})") from None
+    if not found:
         raise ConfigError(f"RUN_DIR {run_dir}: no trajectory.npz there{_why_missing(Path(run_dir))}")
     return path
 

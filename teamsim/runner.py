@@ -157,6 +157,16 @@ def cut_off(summary: dict) -> bool:
     return False
 
 
+def _in_run(filename, run_dir: Path) -> str | None:
+    """The path inside the run folder of the file an OSError names (``learned/red.json``; a temporary or streaming
+    file as the file it would become), or None when it names none there."""
+    if not isinstance(filename, (str, bytes, os.PathLike)):
+        return None
+    path = Path(os.fsdecode(filename))
+    path = path.with_name(path.name.removesuffix(".tmp").removesuffix(".part"))
+    return path.relative_to(run_dir).as_posix() if path.is_relative_to(run_dir) else None
+
+
 def _outputs(run_dir: Path) -> list[str]:
     """The files a run wrote beside its summary (none if its folder is gone)."""
     try:
@@ -172,12 +182,17 @@ def _run_without_physics(config: TrialConfig, mission) -> TrialResult:
         raise ConfigError("--video: a physics-free run has nothing to render; allowed with the physics backend")
     run_dir = make_run_dir(config)
     started = time.perf_counter()
-    summary = mission.run_without_physics(config, run_dir)
-    wall = time.perf_counter() - started
-    summary.update(run_id=run_dir.name, wall_time_s=round(wall, 3), teamsim=teamsim.__version__,
-                   real_time_factor=round(summary["sim_time_s"] / wall, 2) if wall > 0 else None,
-                   faults=[f.describe() for f in config.faults], outputs=_outputs(run_dir) + ["summary.json"])
-    write_json(run_dir / "summary.json", summary)
+    try:
+        summary = mission.run_without_physics(config, run_dir)  # (it writes its figures)
+        wall = time.perf_counter() - started
+        summary.update(run_id=run_dir.name, wall_time_s=round(wall, 3), teamsim=teamsim.__version__,
+                       real_time_factor=round(summary["sim_time_s"] / wall, 2) if wall > 0 else None,
+                       faults=[f.describe() for f in config.faults], outputs=_outputs(run_dir) + ["summary.json"])
+        write_json(run_dir / "summary.json", summary)
+    except OSError as exc:  # a full disk, a folder gone
+        name = _in_run(exc.filename, run_dir) or "its outputs"
+        raise ConfigError(f"--out {run_dir}: could not write {name} ({exc.strerror or exc}); what was written "
+                          "before is kept") from None
     return TrialResult(summary["status"], run_dir, summary)
 
 
@@ -207,8 +222,11 @@ def run_trial(config: TrialConfig, seed: int | None = None, progress: bool | Non
                "mujoco": mujoco.__version__,
                "config": {k: v for k, v in dataclasses.asdict(config).items() if k != "scenario"},
                "scenario": to_data(scenario_of(config, mission)) if config.scenario is not None else None}
-    write_json(run_dir / "summary.json", summary)
-    events = EventLog(run_dir / "events.jsonl")
+    try:  # (the folder took a probe file, yet the disk may be full or the folder gone by now)
+        write_json(run_dir / "summary.json", summary)
+        events = EventLog(run_dir / "events.jsonl")
+    except OSError as exc:
+        raise ConfigError(f"--out {run_dir}: not writable ({exc.strerror or exc})") from None
     world.record = events
     motivation = MotivationRecorder(events)
     world.record_trace = motivation
@@ -236,11 +254,12 @@ def run_trial(config: TrialConfig, seed: int | None = None, progress: bool | Non
     failed_writes: list[str] = []
 
     def keep(name: str, write) -> None:
-        """Write one output; a failed write (a full disk, a folder gone) is noted, and the others still go."""
+        """Write one output; a failed write (a full disk, a folder gone) is noted, naming the file the error names
+        (timeline.svg, learned/red.json) or else ``name``, and the others still go."""
         try:
             write()
         except OSError as exc:
-            failed_writes.append(f"{name} ({exc.strerror or exc})")
+            failed_writes.append(f"{_in_run(exc.filename, run_dir) or name} ({exc.strerror or exc})")
 
     started = time.perf_counter()
     try:
@@ -249,7 +268,7 @@ def run_trial(config: TrialConfig, seed: int | None = None, progress: bool | Non
         completed, metrics = mission.outcome(world)
         status = "completed" if completed else "failed"
         if hasattr(mission, "write_outputs"):  # what a mission keeps beyond the summary (learned statistics, ...)
-            mission.write_outputs(world, run_dir)
+            keep("the mission's outputs", lambda: mission.write_outputs(world, run_dir))
     except PhysicsUnstable as exc:
         status, error = "unstable", str(exc)
     except KeyboardInterrupt:

@@ -165,7 +165,9 @@ def _load(path: Path | None, default: str, key: str) -> tuple[dict, str]:
             data = tomllib.load(stream)
     except FileNotFoundError:
         raise ConfigError(f"{name}: no such file") from None
-    except tomllib.TOMLDecodeError as exc:
+    except OSError as exc:  # a folder, a name too long, no permission
+        raise ConfigError(f"{name}: cannot read ({exc.strerror or exc})") from None
+    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
         raise ConfigError(f"{name}: not valid TOML ({exc})") from None
     if not isinstance(data.get(key), dict) or not data[key]:
         raise ConfigError(f"{name}: {key}: missing; expected one [{key}.ID] table per {key[:-1]}")

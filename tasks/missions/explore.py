@@ -199,10 +199,6 @@ class ExploreMission(ScenarioMission):
         return team_duration(params.team_sizes()[1])
 
     def check_scenario(self, scenario: Scenario) -> None:
-        unknown = [name for name in scenario.robots if name not in TABLE_5_22]
-        if unknown:
-            raise ConfigError(f"robots.{unknown[0]}: explore's robots are Table 5.22's, named "
-                              f"{', '.join(TABLE_5_22)}")
         sx, sy = scenario.arena.size
         if sx != sy:
             raise ConfigError(f"arena.size=[{sx:g}, {sy:g}]: explore's worlds are square; allowed: equal sides")
@@ -272,19 +268,26 @@ def role_names(allocation: Allocation) -> dict[str, str]:
 
 
 def fault_targets(faults, allocation: Allocation, robots: list[str]) -> list:
-    """Faults with role names replaced by the robot holding the role; a name that is neither is an error."""
+    """Faults with role names replaced by the robot holding the role; a name that is neither is an error, naming the
+    fault by its place in the whole schedule (the scenario's, then the command line's) as the scenario's check does."""
     names = role_names(allocation)
     out = []
-    for fault in faults:
+    for k, fault in enumerate(faults):
         if fault.robot not in robots and fault.robot not in names:
-            raise ConfigError(f"--fault {fault.kind}:{fault.robot}@{fault.time:g}: no robot or role "
+            raise ConfigError(f"faults[{k}] {fault.kind}:{fault.robot}@{fault.time:g}: no robot or role "
                               f"{fault.robot!r}; robots: {', '.join(robots)}; roles: {', '.join(names)}")
         out.append(dataclasses.replace(fault, robot=names.get(fault.robot, fault.robot)))
     return out
 
 
 def scenario_allocation(scenario: Scenario) -> Allocation:
-    """The devolution over a scenario's robots, in its task's quantities."""
+    """The devolution over a scenario's robots, in its task's quantities; ConfigError for no robots or one that is
+    not one of Table 5.22's (the allocation knows only their specifications)."""
+    if not scenario.robots:
+        raise ConfigError("robots: a scenario needs at least one robot")
+    unknown = [name for name in scenario.robots if name not in TABLE_5_22]
+    if unknown:
+        raise ConfigError(f"robots.{unknown[0]}: explore's robots are Table 5.22's, named {', '.join(TABLE_5_22)}")
     return team_allocation(list(scenario.robots), scenario.task.planners, scenario.task.explorers)
 
 

@@ -45,6 +45,7 @@ SIDE_IR = "ir_left+ir_right"  # the blind-ir fault's sensor prefixes for the sid
 GOAL_SIZE = (ROOM[0] / 6, ROOM[1] / 2)
 START_X = 0.75  # m from the west wall: clear of a robot following that wall
 START_GAP = 0.6  # m between robots at the start, across the entrance
+SPILL_DRAWS = 1000  # random spots tried per puck before the spill is declared too small for the pucks
 ENTRANCE_HALF_WIDTH = 0.4  # m: the entrance marker drawn on the wall (a marker, not a gap: see docs/decisions.md)
 
 
@@ -142,14 +143,20 @@ class HazardousWasteMission(ScenarioMission):
     @staticmethod
     def spill_layout(params: HazardousWasteParams, rng: np.random.Generator) -> list[tuple[float, float]]:
         """Puck centres scattered uniformly in the spill square at the centre of the front third, at least a
-        puck's diameter plus 1 cm apart."""
+        puck's diameter plus 1 cm apart; ConfigError if ``SPILL_DRAWS`` draws per puck do not place them all (too
+        many pucks for the square)."""
         centre = np.array([-ROOM[0] / 2 + ROOM[0] / 6, 0.0])
         gap = 2 * PuckDims().radius + 0.01
         points: list[np.ndarray] = []
-        while len(points) < params.pucks:
+        draws = 0
+        while len(points) < params.pucks and draws < SPILL_DRAWS * params.pucks:
+            draws += 1
             p = centre + rng.uniform(-0.5, 0.5, size=2) * params.spill_size
             if all(np.hypot(*(p - q)) >= gap for q in points):
                 points.append(p)
+        if len(points) < params.pucks:
+            raise ConfigError(f"pucks={params.pucks}: that many pucks {gap:g} m apart do not fit in a spill of "
+                              f"{params.spill_size:g} m (spill_size); allowed: fewer pucks or a larger spill_size")
         return [(float(x), float(y)) for x, y in points]
 
     def check_scenario(self, scenario: Scenario) -> None:

@@ -40,7 +40,8 @@ def failure_kind(times, xy, v_max: float, criteria: LoopCriteria = LoopCriteria(
     travelled = float(np.hypot(*np.diff(p, axis=0).T).sum())
     if duration <= 0 or travelled / duration < criteria.stalled_share * v_max:
         return kind | {"failure": "stalled"}
-    picks = np.searchsorted(t, np.arange(t[0], t[-1] + 1e-9, criteria.sample_period))
+    # (np.arange's float steps can end a hair past t[-1], where searchsorted answers len(t): clip to the last sample)
+    picks = np.minimum(np.searchsorted(t, np.arange(t[0], t[-1] + 1e-9, criteria.sample_period)), len(t) - 1)
     t, p = t[picks], p[picks]
     returns = [_return_time(t, p, i, criteria.revisit_radius) for i in range(len(t) // 2)]
     found = [r for r in returns if r is not None]

@@ -24,7 +24,7 @@ from teamsim.config import TrialConfig
 from teamsim.faults import Fault
 from teamsim.files import write_atomic, write_csv
 from teamsim.plots import grouped_bars
-from teamsim.sweep import run_trials
+from teamsim.sweep import JOURNAL_NAME, run_trials
 from teamsim.tasks.missions.hazardous_waste import TEAMS, HazardousWasteParams
 from teamsim.tasks.studies import findings
 from teamsim.tasks.studies.findings import Finding, verdict
@@ -44,6 +44,7 @@ class AwarenessStudy:
     workers: int | None = None
     out: Path = Path("renders/study-awareness")
     duration: float | None = None
+    resume: bool = False  # continue the study in ``out`` from its journal (trials.jsonl), issue 29
 
 
 def trial_configs(study: AwarenessStudy) -> list[TrialConfig]:
@@ -75,7 +76,8 @@ def result_row(config: TrialConfig, summary: dict) -> dict:
 
 def run_study(study: AwarenessStudy) -> Path:
     configs = trial_configs(study)
-    summaries = run_trials(configs, workers=study.workers)
+    summaries = run_trials(configs, workers=study.workers, journal=study.out / JOURNAL_NAME,
+                           resume=study.resume)
     rows = [result_row(c, s) for c, s in zip(configs, summaries)]
     study.out.mkdir(parents=True, exist_ok=True)
     write_csv(study.out / "results.csv", COLUMNS, rows)

@@ -29,7 +29,7 @@ from teamsim.controllers.behaviours.box_pushing import BoxPushParams
 from teamsim.faults import Fault
 from teamsim.files import write_atomic, write_csv
 from teamsim.stats import paired_t_test, ratio_ci
-from teamsim.sweep import run_trials
+from teamsim.sweep import JOURNAL_NAME, run_trials
 from teamsim.tasks.missions.box_pushing import BoxPushingParams
 from teamsim.tasks.studies.findings import interval_text
 
@@ -58,6 +58,7 @@ class BoxPushingStudy:
     settle: float = 20.0  # s after a change that rates and the pair's split are not counted over
     workers: int | None = None
     out: Path = Path("renders/study-box-pushing")
+    resume: bool = False  # continue the study in ``out`` from its journal (trials.jsonl), issue 29
 
 
 def change_time(study: BoxPushingStudy, trial: int) -> float:
@@ -142,7 +143,8 @@ def result_row(study: BoxPushingStudy, config: TrialConfig, summary: dict) -> di
 
 def run_study(study: BoxPushingStudy) -> Path:
     configs = [trial_config(study, e, k) for e in study.experiments for k in range(study.trials)]
-    summaries = run_trials(configs, workers=study.workers)
+    summaries = run_trials(configs, workers=study.workers, journal=study.out / JOURNAL_NAME,
+                           resume=study.resume)
     rows = [result_row(study, c, s) for c, s in zip(configs, summaries)]
     study.out.mkdir(parents=True, exist_ok=True)
     write_csv(study.out / "results.csv", COLUMNS, rows, float_format=".4g")

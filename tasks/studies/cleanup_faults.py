@@ -29,7 +29,7 @@ import numpy as np
 from teamsim.config import TrialConfig
 from teamsim.faults import Fault
 from teamsim.files import write_atomic, write_csv
-from teamsim.sweep import run_trials
+from teamsim.sweep import JOURNAL_NAME, run_trials
 from teamsim.tasks.missions.hazardous_waste import TEAMS, HazardousWasteParams
 from teamsim.tasks.studies import findings
 from teamsim.tasks.studies.findings import Finding, verdict
@@ -50,6 +50,7 @@ class CleanupFaultStudy:
     gripper_break: float = 100.0  # s: after the search, while the team is moving the spill (README's example)
     workers: int | None = None
     out: Path = Path("renders/study-cleanup-faults")
+    resume: bool = False  # continue the study in ``out`` from its journal (trials.jsonl), issue 29
 
 
 def faults_of(study: CleanupFaultStudy, condition: str, mission: int) -> tuple[list[Fault], float | None]:
@@ -99,7 +100,8 @@ def result_row(study: CleanupFaultStudy, config: TrialConfig, summary: dict) -> 
 
 def run_study(study: CleanupFaultStudy) -> Path:
     configs = trial_configs(study)
-    summaries = run_trials(configs, workers=study.workers)
+    summaries = run_trials(configs, workers=study.workers, journal=study.out / JOURNAL_NAME,
+                           resume=study.resume)
     rows = [result_row(study, c, s) for c, s in zip(configs, summaries)]
     study.out.mkdir(parents=True, exist_ok=True)
     write_csv(study.out / "results.csv", COLUMNS, rows)

@@ -18,7 +18,7 @@ from teamsim.config import TrialConfig
 from teamsim.controllers.behaviours.formation import STRATEGIES
 from teamsim.files import write_atomic, write_csv
 from teamsim.plots import pyplot, save_figure
-from teamsim.sweep import run_trials
+from teamsim.sweep import JOURNAL_NAME, run_trials
 from teamsim.tasks.missions.formation import FormationMission, FormationParams
 from teamsim.tasks.studies.findings import Comparison, Finding, compare, paired, table
 
@@ -43,6 +43,7 @@ class FormationStudy:
     workers: int | None = None
     out: Path = Path("renders/study-formation")
     duration: float | None = None
+    resume: bool = False  # continue the study in ``out`` from its journal (trials.jsonl), issue 29
 
 
 def condition(run: int) -> tuple[str, int]:
@@ -77,7 +78,8 @@ def result_row(config: TrialConfig, summary: dict) -> dict:
 
 def run_study(study: FormationStudy) -> Path:
     configs = trial_configs(study)
-    return write_results(study, configs, run_trials(configs, workers=study.workers))
+    summaries = run_trials(configs, workers=study.workers, journal=study.out / JOURNAL_NAME, resume=study.resume)
+    return write_results(study, configs, summaries)
 
 
 def write_results(study: FormationStudy, configs: list[TrialConfig], summaries: list[dict]) -> Path:

@@ -18,7 +18,8 @@ from scipy.stats import wilcoxon
 from teamsim.config import TrialConfig
 from teamsim.files import write_atomic, write_csv
 from teamsim.plots import pyplot, save_figure
-from teamsim.sweep import run_trials
+from teamsim.stats import ratio_ci
+from teamsim.sweep import JOURNAL_NAME, run_trials
 from teamsim.tasks.missions.janitorial import JanitorialMission, JanitorialParams
 from teamsim.tasks.studies.findings import Finding, verdict
 
@@ -40,6 +41,7 @@ class JanitorialRhoStudy:
     workers: int | None = None
     out: Path = Path("renders/study-janitorial-rho")
     duration: float | None = None
+    resume: bool = False  # continue the study in ``out`` from its journal (trials.jsonl), issue 29
 
 
 def rhos_of(study: JanitorialRhoStudy) -> list[float]:
@@ -78,7 +80,8 @@ def result_row(config: TrialConfig, summary: dict) -> dict:
 
 def run_study(study: JanitorialRhoStudy) -> Path:
     configs = trial_configs(study)
-    return write_results(study, configs, run_trials(configs, workers=study.workers))
+    summaries = run_trials(configs, workers=study.workers, journal=study.out / JOURNAL_NAME, resume=study.resume)
+    return write_results(study, configs, summaries)
 
 
 def write_results(study: JanitorialRhoStudy, configs: list[TrialConfig], summaries: list[dict]) -> Path:
@@ -120,12 +123,14 @@ def wilcoxon_p(a: list[float], b: list[float]) -> float:
 
 
 def step(rows: list[dict], a: float, b: float) -> dict:
-    """Rho a against rho b: the ratio of their mean times (completed runs), the pairs both completed, their p."""
+    """Rho a against rho b: the ratio of their mean times (completed runs), the pairs both completed, the 95 %
+    confidence interval of the ratio over those pairs (Fieller, ``teamsim.stats.ratio_ci``) and their p."""
     first, second = times(rows, a), times(rows, b)
     seeds = sorted(set(first) & set(second))
     ratio = mean_sd(second.values())[0] / mean_sd(first.values())[0] if first and second else math.nan
     few = min(len(first), len(second)) < MIN_COMPLETED
-    return {"ratio": ratio, "pairs": len(seeds), "few": few,
+    _, low, high = ratio_ci([second[s] for s in seeds], [first[s] for s in seeds])
+    return {"ratio": ratio, "pairs": len(seeds), "few": few, "ci": (low, high),
             "biased": any(not r["completed"] for r in at(rows, a) + at(rows, b)),
             "p": wilcoxon_p([first[s] for s in seeds], [second[s] for s in seeds])}
 
@@ -148,6 +153,8 @@ def claims(rows: list[dict], rhos: list[float]) -> list[tuple[Finding, int | Non
         s = step(rows, a, b)
         change = 100 * (s["ratio"] - 1)
         figure = "no mean" if math.isnan(change) else f"x{s['ratio']:.2f} ({change:+.0f} %)"
+        if not math.isnan(s["ci"][0]):
+            figure += f" [95 % CI of the paired ratio: x{s['ci'][0]:.2f} to x{s['ci'][1]:.2f}]"
         if s["biased"] and not math.isnan(change):
             figure += ", biased: not every run completed"
         if s["few"]:

@@ -43,8 +43,8 @@ import numpy as np
 
 from teamsim.files import write_atomic, write_csv
 from teamsim.rng import RandomStreams
-from teamsim.stats import paired_t_test
-from teamsim.sweep import worker_pool
+from teamsim.stats import paired_t_test, ratio_ci
+from teamsim.sweep import JOURNAL_NAME, run_trials
 from teamsim.tasks.worlds.abstract_allocation import (TeamSettings, draw_problem, optimal_energy, optimal_time,
                                                       run_team)
 
@@ -224,32 +224,39 @@ def _expected_cost(job: ScenarioJob) -> float:
     return job.runs * len(job.variants) * job.m * (job.coverage + 1)
 
 
-def run_jobs(jobs: list[ScenarioJob], workers: int) -> list[dict]:
-    """Rows of every job, in the order of ``jobs`` whatever the number of workers (spawned processes)."""
-    if workers <= 1:
+def run_jobs(jobs: list[ScenarioJob], workers: int, journal: Path | None = None, resume: bool = False) -> list[dict]:
+    """Rows of every job, in the order of ``jobs`` whatever the number of workers (spawned processes). With a
+    ``journal`` each finished job is kept there and ``resume`` runs only the jobs it lacks (teamsim.sweep)."""
+    if workers <= 1 and journal is None:
         results = [run_scenario(job) for job in jobs]
     else:
-        order = sorted(range(len(jobs)), key=lambda k: -_expected_cost(jobs[k]))
-        with worker_pool(workers) as pool:
-            done = dict(zip(order, pool.map(run_scenario, [jobs[k] for k in order], chunksize=1)))
+        order = sorted(range(len(jobs)), key=lambda k: -_expected_cost(jobs[k]))  # the longest first
+        ran = run_trials([jobs[k] for k in order], workers=max(1, workers), run=run_scenario, journal=journal,
+                         resume=resume)
+        dead = [(jobs[k], r) for k, r in zip(order, ran) if isinstance(r, dict)]  # a worker that died
+        if dead:
+            job, result = dead[0]
+            raise RuntimeError(f"lalliance scenario {job.n}-{job.m}-{job.coverage} ({job.part}): {result.get('error')}")
+        done = dict(zip(order, ran))
         results = [done[k] for k in range(len(jobs))]
     return [row for rows in results for row in rows]
 
 
-def study_rows(study: StudyPlan, seed: int = 0, workers: int = 1) -> list[dict]:
-    """Every run of ``study`` (one dict per row of ``results.csv``), without writing anything."""
-    return run_jobs(_jobs(study, seed), workers)
+def study_rows(study: StudyPlan, seed: int = 0, workers: int = 1, journal: Path | None = None,
+               resume: bool = False) -> list[dict]:
+    """Every run of ``study`` (one dict per row of ``results.csv``), without writing anything but ``journal``."""
+    return run_jobs(_jobs(study, seed), workers, journal, resume)
 
 
 def run_study(out_dir: str | Path, workers: int, full: bool = False, runs: int | None = None, seed: int = 0,
-              study: StudyPlan | None = None) -> dict:
+              study: StudyPlan | None = None, resume: bool = False) -> dict:
     """Run the study, write ``results.csv`` and ``report.md`` into ``out_dir``; return their paths and the wall
     time. ``study`` replaces the plan chosen by ``full`` and ``runs``."""
     study = study or plan(full, runs)
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     start = time.perf_counter()
-    rows = study_rows(study, seed, workers)
+    rows = study_rows(study, seed, workers, out / JOURNAL_NAME, resume)
     wall = time.perf_counter() - start
     csv_path, report_path = out / "results.csv", out / "report.md"
     write_csv(csv_path, COLUMNS, rows, float_format=".6f")
@@ -497,6 +504,12 @@ def _fastest_share(rows: list[dict], default_boredom: float) -> dict[tuple, floa
     return {k: float(np.mean(v)) for k, v in shares.items()}
 
 
+def _change_ci(a, b) -> str:
+    """The 95 % confidence interval of mean(a) / mean(b) - 1, paired run by run (Fieller), as "[lo, hi %]"."""
+    _, low, high = ratio_ci(a, b)
+    return f"[{100 * (low - 1):+.1f}, {100 * (high - 1):+.1f} %]"
+
+
 def _region1(groups_time: dict, groups_energy: dict, rows: list[dict], default_boredom: float
              ) -> tuple[list[str], Verdict]:
     """Claim 8, region 1: II and III much better than I (at least MUCH_BETTER below it) in time and energy, per
@@ -521,8 +534,8 @@ def _region1(groups_time: dict, groups_energy: dict, rows: list[dict], default_b
             setting = f"PWW {'yes' if pww else 'no'}, {metric}"
             figures.append(f"{setting}: II {100 * change['II']:+.1f} %, III {100 * change['III']:+.1f} %")
             lines.append(f"  - {setting}, mean over the mean of I-III: I {means['I']:.3f}, II {means['II']:.3f}, III "
-                         f"{means['III']:.3f} (II {100 * change['II']:+.1f} %, III {100 * change['III']:+.1f} % "
-                         "against I)")
+                         f"{means['III']:.3f} (II {100 * change['II']:+.1f} % {_change_ci(runs['II'], runs['I'])}, "
+                         f"III {100 * change['III']:+.1f} % {_change_ci(runs['III'], runs['I'])} against I)")
             for s in ("II", "III"):
                 if change[s] > -MUCH_BETTER:
                     cause = ("region1_ii" if (s, pww, metric) == ("II", False, "time") else
@@ -549,14 +562,15 @@ def _ordering_lines(rows: list[dict]) -> tuple[list[str], list[Verdict]]:
     times: dict[tuple, list[float]] = defaultdict(list)
     for r in sorted(ordering, key=lambda r: r["run"]):  # run by run, the same problems under every ordering
         times[(r["strategy"], r["ordering"])].append(r["time"])
-    lines = ["| strategy | Shortest Task First, mean time | Random, mean time | random vs STF | thesis |",
+    lines = ["| strategy | Shortest Task First, mean time | Random, mean time | random vs STF [95 % CI] | thesis |",
              "|---|---|---|---|---|"]
     change = {}
     expectation = {"I": "degrades most", "II": "improves", "III": "degrades somewhat"}
     for s in ("I", "II", "III"):
         stf, rnd = np.mean(times[(s, "shortest_first")]), np.mean(times[(s, "random")])
         change[s] = rnd / stf - 1
-        lines.append(f"| {s} | {stf:.1f} | {rnd:.1f} | {100 * change[s]:+.1f} % | {expectation[s]} |")
+        lines.append(f"| {s} | {stf:.1f} | {rnd:.1f} | {100 * change[s]:+.1f} % "
+                     f"{_change_ci(times[(s, 'random')], times[(s, 'shortest_first')])} | {expectation[s]} |")
     random_claim.teamsim = ", ".join(f"{s} {100 * change[s]:+.1f} %" for s in ("I", "II", "III"))
     expected = {"I": change["I"] > max(change["III"], 0), "III": change["I"] > change["III"] > 0,
                 "II": change["II"] < 0}

@@ -29,7 +29,7 @@ from teamsim.config import TrialConfig
 from teamsim.files import write_atomic, write_csv
 from teamsim.plots import grouped_bars
 from teamsim.stats import paired_t_test, ratio_ci
-from teamsim.sweep import default_workers, run_trials
+from teamsim.sweep import JOURNAL_NAME, default_workers, run_trials
 from teamsim.tasks.missions.navigate import (TABLE_3_1, THESIS_METHODS, WORLD_FAMILIES, NavigateParams,
                                             kinematic_trial, time_limit)
 from teamsim.tasks.studies.findings import interval_text
@@ -69,6 +69,7 @@ class NavigationStudy:
     seed: int = 0
     backend: str = "kinematic"  # or "physics" (see the module's docstring)
     worlds: str = "strata"  # the world family, NavigateParams.worlds
+    resume: bool = False  # continue the study in ``out`` from its journal (trials.jsonl), issue 29
 
     def __post_init__(self) -> None:
         if self.backend not in BACKENDS:
@@ -165,7 +166,8 @@ def compare(cells: dict, robot: str, density: float, controller: str) -> dict:
 def run_study(study: NavigationStudy) -> Path:
     configs = trial_configs(study)
     began = time.perf_counter()
-    summaries = run_trials(configs, workers=study.workers, run=BACKENDS[study.backend])
+    summaries = run_trials(configs, workers=study.workers, run=BACKENDS[study.backend],
+                           journal=study.out / JOURNAL_NAME, resume=study.resume)
     wall_s = time.perf_counter() - began
     rows = [result_row(c, s) for c, s in zip(configs, summaries)]
     study.out.mkdir(parents=True, exist_ok=True)

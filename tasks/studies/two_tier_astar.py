@@ -42,7 +42,7 @@ from teamsim.files import write_atomic, write_csv
 from teamsim.plots import grouped_bars
 from teamsim.rng import RandomStreams
 from teamsim.stats import paired_t_test, ratio_ci
-from teamsim.sweep import run_trials
+from teamsim.sweep import JOURNAL_NAME, run_trials
 from teamsim.tasks.studies.findings import interval_text
 
 RESOLUTION = 0.1  # m per node (§4.6)
@@ -221,14 +221,14 @@ def run_world(job: WorldJob) -> dict:
     return {"status": "completed", "rows": rows}
 
 
-def run_study(study: TwoTierStudy, out: Path, workers: int = 1) -> dict:
+def run_study(study: TwoTierStudy, out: Path, workers: int = 1, resume: bool = False) -> dict:
     """Run the study; write ``results.csv``, ``report.md`` and the plots into ``out``. Planning times are wall
     times, so more than one worker on a busy machine makes them noisier (the default is one)."""
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     began = time.perf_counter()
     world_jobs = jobs(study)
-    results = run_trials(world_jobs, workers=workers, run=run_world)
+    results = run_trials(world_jobs, workers=workers, run=run_world, journal=out / JOURNAL_NAME, resume=resume)
     wall = time.perf_counter() - began
     rows = [row for result in results for row in result.get("rows", [])]
     failed = [f"{world_label(j.nodes)} {j.density:.0%} world {j.trial}: {r.get('error')}"

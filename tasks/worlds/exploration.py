@@ -218,7 +218,8 @@ def _bogs(params: ExploreWorldParams, nav: NavWorld, base: tuple[float, float],
             return tuple(bogs)
         boggy |= covered
         bogs.append(bog)
-    raise RuntimeError(f"could not reach {params.bog_share:.0%} boggy ground in {params.bog_attempts} patches")
+    raise ConfigError(f"explore: bog_share={params.bog_share:g}: could not reach {params.bog_share:.0%} boggy "
+                      f"ground in {params.bog_attempts} patches; allowed: a smaller bog_share")
 
 
 def _patch(params: ExploreWorldParams, rng: np.random.Generator) -> Bog:

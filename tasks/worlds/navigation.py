@@ -41,6 +41,7 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit
 
+from teamsim.config import ConfigError
 from teamsim.controllers.base import Observation
 from teamsim.controllers.navigation.astar import modified_astar
 from teamsim.controllers.navigation.occupancy_grid import OccupancyGrid
@@ -116,7 +117,8 @@ def random_world(density: float, rng: np.random.Generator, params: NavWorldParam
 def first_passable(density: float, rng: np.random.Generator, params, layout) -> NavWorld:
     """The first of up to ``params.layouts`` layouts drawn by ``layout(density, rng, params, (start, goal))`` that
     reaches the density and lets a circle of ``params.passage_radius`` from the start to the goal; a layout that
-    jams short of the density (None) or leaves no passage is dropped and the next drawn."""
+    jams short of the density (None) or leaves no passage is dropped and the next drawn. If none does, the density
+    is out of reach: ConfigError naming it."""
     half = params.size / 2
     start = (-half + params.corner_margin, half - params.corner_margin)
     goal = (half - params.corner_margin, -half + params.corner_margin)
@@ -130,8 +132,8 @@ def first_passable(density: float, rng: np.random.Generator, params, layout) -> 
                          (start[0], start[1], heading), goal)
         if has_passage(world, params.passage_radius):
             return world
-    raise RuntimeError(f"could not reach {density:.0%} obstacle density with a passage for a "
-                       f"{params.passage_radius} m circle in {params.layouts} layouts")
+    raise ConfigError(f"density={density:g}: no world of {density:.0%} obstacle density with a passage for a "
+                      f"{params.passage_radius} m circle in {params.layouts} layouts; allowed: a lower density")
 
 
 def _layout(density: float, rng: np.random.Generator, params: NavWorldParams,

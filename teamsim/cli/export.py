@@ -25,6 +25,8 @@ def robot_on_floor(kind: str) -> mjcf.RootElement:
 
 
 def export_robot(kind: str, out: Path) -> None:
+    if not Path(out).name:  # "", ".", "/": a folder, not a file to write
+        raise ConfigError(f"--out {str(out)!r}: expected a file path, e.g. {kind}.xml")
     xml = robot_on_floor(kind).to_xml_string()
     try:
         Path(out).parent.mkdir(parents=True, exist_ok=True)

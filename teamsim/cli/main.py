@@ -5,6 +5,7 @@ Every bad input ends in one line, ``teamsim: error: ...``, and exit status 2.
 from __future__ import annotations
 
 import argparse
+import math
 import os
 import sys
 from pathlib import Path
@@ -18,6 +19,9 @@ CLEANUP_CONDITIONS = ("none", "kill-red", "radio-off", "break-gripper")
 BOX_EXPERIMENTS = ("robot-failure", "heterogeneity")  # teamsim.tasks.studies.box_pushing.EXPERIMENTS
 JANITORIAL_RHOS = (0.0, 0.1, 0.5, 2.0)  # teamsim.tasks.studies.janitorial_rho.JanitorialRhoStudy.rhos
 FORMATION_STRATEGIES = ("I", "II", "III", "IV")  # teamsim.controllers.behaviours.formation.STRATEGIES
+# teamsim.tasks.studies.robustness.MISSIONS
+ROBUSTNESS_MISSIONS = ("wander", "navigate", "hazardous-waste", "box-pushing", "explore", "janitorial",
+                       "bounding-overwatch", "formation")
 
 EXIT_USAGE = 2
 
@@ -90,7 +94,8 @@ def _build_parser() -> argparse.ArgumentParser:
     navigation.add_argument("--trials", type=_positive_int("--trials"))
     navigation.add_argument("--workers", type=_positive_int("--workers"))
     navigation.add_argument("--seed", type=int)
-    navigation.add_argument("--out", type=Path, default=Path("renders/study-navigation"))
+    navigation.add_argument("--out", type=Path, help="output folder (default: renders/study-navigation)")
+    _resume_option(navigation, "renders/study-navigation")
     navigation.add_argument("--backend", choices=("kinematic", "physics"),
                             help="kinematic (default: no dynamics, as the thesis simulated; minutes) or physics "
                                  "(every trial a MuJoCo navigate mission)")
@@ -145,10 +150,22 @@ def _build_parser() -> argparse.ArgumentParser:
     formation.add_argument("--duration", type=float, help="simulated seconds per run (mission default if unset)")
     _run_options(formation, workers=2, out="renders/study-formation")
 
+    robust = studies.add_parser("robustness", help="every mission under every fault kind it supports, over seeds "
+                                                   "(issue 29)")
+    robust.add_argument("--seeds", default="1", metavar="N|A-B", help="trial seeds: N (0..N-1) or a range A-B "
+                                                                      "(default: 1, i.e. 61 runs)")
+    robust.add_argument("--missions", type=_csv_of("mission", ROBUSTNESS_MISSIONS), default=ROBUSTNESS_MISSIONS,
+                        help=f"comma-separated (default: all): {','.join(ROBUSTNESS_MISSIONS)}")
+    robust.add_argument("--faults", type=_csv_of("fault", FAULT_KINDS), default=FAULT_KINDS,
+                        help=f"comma-separated fault kinds (default: all): {','.join(FAULT_KINDS)}")
+    robust.add_argument("--duration", type=float, help="simulated seconds per run (default: each mission's own)")
+    _run_options(robust, workers=2, out="renders/study-robustness")
+
     bench = commands.add_parser("bench", help="benchmarks")
     bench.add_argument("what", choices=("physics", "cleanup", "box-pushing", "janitorial", "formation", "overwatch",
                                         "render", "nav", "alliance", "allocate", "sweep", "explore"))
-    bench.add_argument("--seconds", type=float, default=None, help="simulated seconds per measurement")
+    bench.add_argument("--seconds", type=_seconds("--seconds"), default=None,
+                       help="simulated seconds per measurement")
     return parser
 
 
@@ -175,7 +192,22 @@ def _run_options(parser: argparse.ArgumentParser, workers: int, out: str) -> Non
     """--workers, --seed and --out of a study."""
     parser.add_argument("--workers", type=_positive_int("--workers"), default=workers)
     parser.add_argument("--seed", type=int, default=0)
-    parser.add_argument("--out", type=Path, default=Path(out))
+    parser.add_argument("--out", type=Path, help=f"output folder (default: {out})")
+    _resume_option(parser, out)
+
+
+def _resume_option(parser: argparse.ArgumentParser, out: str) -> None:
+    parser.add_argument("--resume", type=Path, metavar="DIR", help="continue a study killed in DIR (its --out): the "
+                                                                   "trials in DIR/trials.jsonl are not run again")
+    parser.set_defaults(default_out=Path(out))
+
+
+def _study_out(args) -> None:
+    """``--resume DIR`` is ``--out DIR`` with the journal reused; --out alone defaults to the study's folder."""
+    if args.resume is not None and args.out is not None and args.out.resolve() != args.resume.resolve():
+        raise UsageError(f"--out {args.out} and --resume {args.resume}: a study resumes in its own folder; give one")
+    args.out = args.resume or args.out or args.default_out
+    args.resume = args.resume is not None
 
 
 def _csv_of(name: str, allowed: tuple | None, kind=str):
@@ -193,6 +225,19 @@ def _csv_of(name: str, allowed: tuple | None, kind=str):
     return parse
 
 
+def _seconds(flag: str):
+    """An argparse type: simulated seconds, a number in (0, 1e7] (TrialConfig.duration's bounds)."""
+    def parse(text: str) -> float:
+        try:
+            value = float(text)
+        except ValueError:
+            value = math.nan
+        if not 0 < value <= 1e7:  # (NaN fails too)
+            raise argparse.ArgumentTypeError(f"{flag} must be a number of simulated seconds in (0, 1e7]")
+        return value
+    return parse
+
+
 def _positive_int(flag: str):
     def parse(text: str) -> int:
         if not text.isdigit() or int(text) < 1:
@@ -202,6 +247,7 @@ def _positive_int(flag: str):
 
 
 def cmd_study(args) -> int:
+    _study_out(args)
     if args.study == "navigation":
         from teamsim.tasks.studies.navigation import run_study, study_from_args
 
@@ -209,13 +255,13 @@ def cmd_study(args) -> int:
             raise ConfigError("--densities: each must be in (0, 0.3]")
         study = study_from_args(robots=args.robots, densities=args.densities, controllers=args.controllers,
                                 trials=args.trials, workers=args.workers, out=args.out, seed=args.seed,
-                                backend=args.backend, worlds=args.worlds)
+                                backend=args.backend, worlds=args.worlds, resume=args.resume)
         out = run_study(study)
         print(f"wrote {out / 'report.md'} and {out / 'results.csv'}")
     elif args.study == "two-tier-astar":
         from teamsim.tasks.studies.two_tier_astar import plan, run_study
 
-        written = run_study(plan(args.full, args.trials, args.seed), args.out, args.workers)
+        written = run_study(plan(args.full, args.trials, args.seed), args.out, args.workers, resume=args.resume)
         print(f"wrote {written['report']} and {written['results']} ({written['rows']} plans, "
               f"{written['wall_s']:.0f} s)")
     elif args.study == "awareness":
@@ -224,7 +270,7 @@ def cmd_study(args) -> int:
         if args.duration is not None and not args.duration > 0:
             raise ConfigError("--duration: must be > 0 simulated seconds")
         out = run_study(AwarenessStudy(missions=args.missions, seed=args.seed, workers=args.workers, out=args.out,
-                                       duration=args.duration))
+                                       duration=args.duration, resume=args.resume))
         print(f"wrote {out / 'report.md'} and {out / 'results.csv'}")
     elif args.study == "janitorial-rho":
         if not all(0.0 <= rho <= 100.0 for rho in args.rhos):  # (NaN fails too)
@@ -234,19 +280,20 @@ def cmd_study(args) -> int:
         from teamsim.tasks.studies.janitorial_rho import JanitorialRhoStudy, run_study
 
         out = run_study(JanitorialRhoStudy(rhos=args.rhos, missions=args.missions, seed=args.seed,
-                                           workers=args.workers, out=args.out, duration=args.duration))
+                                           workers=args.workers, out=args.out, duration=args.duration,
+                                           resume=args.resume))
         print(f"wrote {out / 'report.md'}, {out / 'times.png'} and {out / 'results.csv'}")
     elif args.study == "cleanup-faults":
         from teamsim.tasks.studies.cleanup_faults import CleanupFaultStudy, run_study
 
         out = run_study(CleanupFaultStudy(missions=args.missions, seed=args.seed, conditions=args.conditions,
-                                          workers=args.workers, out=args.out))
+                                          workers=args.workers, out=args.out, resume=args.resume))
         print(f"wrote {out / 'report.md'} and {out / 'results.csv'}")
     elif args.study == "box-pushing":
         from teamsim.tasks.studies.box_pushing import BoxPushingStudy, run_study
 
         out = run_study(BoxPushingStudy(trials=args.trials, seed=args.seed, experiments=args.experiments,
-                                        workers=args.workers, out=args.out))
+                                        workers=args.workers, out=args.out, resume=args.resume))
         print(f"wrote {out / 'report.md'} and {out / 'results.csv'}")
     elif args.study == "formation":
         if args.duration is not None and not args.duration > 0:
@@ -254,14 +301,28 @@ def cmd_study(args) -> int:
         from teamsim.tasks.studies.formation import FormationStudy, run_study
 
         out = run_study(FormationStudy(runs=args.runs, seed=args.seed, strategies=args.strategies,
-                                       workers=args.workers, out=args.out, duration=args.duration))
+                                       workers=args.workers, out=args.out, duration=args.duration,
+                                       resume=args.resume))
         print(f"wrote {out / 'report.md'}, {out / 'fig7-2.png'} and {out / 'results.csv'}")
     elif args.study == "lalliance":
         from teamsim.tasks.studies.lalliance import run_study
 
-        written = run_study(args.out, args.workers, full=args.full, runs=args.runs, seed=args.seed)
+        written = run_study(args.out, args.workers, full=args.full, runs=args.runs, seed=args.seed,
+                            resume=args.resume)
         print(f"wrote {written['report']} and {written['results']} ({written['rows']} runs, "
               f"{written['wall_s']:.0f} s)")
+    elif args.study == "robustness":
+        import time
+
+        from teamsim.tasks.studies.robustness import RobustnessStudy, run_study, seeds_from
+
+        if args.duration is not None and not args.duration > 0:
+            raise ConfigError("--duration: must be > 0 simulated seconds")
+        began = time.perf_counter()
+        out = run_study(RobustnessStudy(seeds=seeds_from(args.seeds), seed=args.seed, missions=args.missions,
+                                        faults=args.faults, duration=args.duration, workers=args.workers,
+                                        out=args.out, resume=args.resume))
+        print(f"wrote {out / 'report.md'} and {out / 'results.csv'} ({time.perf_counter() - began:.0f} s)")
     return 0
 
 
@@ -338,6 +399,7 @@ def cmd_list(_args) -> int:
     print("  cleanup-faults   Parker §3.8.4: the cleanup with red killed, the radio off, a gripper broken")
     print("  box-pushing      Parker §6.1.2: an R-2 taken away and returned; an R-2 replaced by Genghis-II")
     print("  formation        Parker §7.2: keeping formation under strategies I-IV (Fig. 7-2)")
+    print("  robustness       every mission under every fault kind it supports, over seeds (issue 29)")
     return 0
 
 
@@ -409,6 +471,16 @@ def cmd_bench(args) -> int:
     return 0
 
 
+# Every character that ends a line (str.splitlines) or moves the cursor back over it, as its escape.
+_LINE_BREAKS = {ord(c): c.encode("unicode_escape").decode() for c in "\n\r\v\f\x1c\x1d\x1e\x85\u2028\u2029"}
+
+
+def one_line(message: str) -> str:
+    """An error message on one line: a line break in it (from an argument: ``--set 'robots=1<newline>2'``) is
+    written as its escape."""
+    return message.translate(_LINE_BREAKS)
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = _build_parser()
     try:
@@ -417,7 +489,7 @@ def main(argv: list[str] | None = None) -> int:
                 "bench": cmd_bench, "study": cmd_study, "allocate": cmd_allocate,
                 "scenario": cmd_scenario, "view": cmd_view}[args.command](args)
     except (UsageError, ConfigError, RenderBackendError) as exc:
-        print(f"teamsim: error: {exc}", file=sys.stderr)
+        print(f"teamsim: error: {one_line(str(exc))}", file=sys.stderr)
         return EXIT_USAGE
     except BrokenPipeError:  # the output went to a program that stopped reading (teamsim list | head)
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())  # no second error at interpreter exit

@@ -12,7 +12,7 @@ from pathlib import Path
 import pytest
 
 from teamsim.runner import run_trial
-from teamsim.sweep import run_trials
+from teamsim.sweep import JournalError, run_trials
 from tests.helpers import wander_config
 
 
@@ -92,3 +92,108 @@ def test_workers_die_with_a_killed_parent(tmp_path):
             pid = int(p.read_text())
             if _alive(pid):
                 os.kill(pid, signal.SIGKILL)
+
+
+# -- the journal (issue 29): a killed sweep resumes without re-running its finished trials --------------------------
+def _echo(config) -> dict:
+    """A trial stand-in: its result is made of its configuration (a tuple here: any picklable object)."""
+    name, k = config
+    return {"status": "failed" if k % 3 == 0 else "completed", "value": k / 7, "pair": (k, name), "nan": float("nan")}
+
+
+class _Stop:
+    """A trial stand-in that is interrupted (as by Ctrl-C) at call ``at``, counting its calls."""
+
+    def __init__(self, at: int | None = None):
+        self.at, self.calls = at, []
+
+    def __call__(self, config) -> dict:
+        if len(self.calls) == self.at:
+            raise KeyboardInterrupt
+        self.calls.append(config)
+        return _echo(config)
+
+
+def _configs(n: int = 6, name: str = "a") -> list:
+    return [(name, k) for k in range(n)]
+
+
+def _same(a, b) -> bool:  # equal, NaN included
+    import json
+
+    return json.dumps(a) == json.dumps(b)
+
+
+def test_a_resumed_sweep_runs_only_the_missing_trials_and_returns_the_same(tmp_path):
+    journal = tmp_path / "trials.jsonl"
+    whole = run_trials(_configs(), workers=1, run=_echo, journal=tmp_path / "whole.jsonl")
+    killed = _Stop(at=4)
+    with pytest.raises(KeyboardInterrupt):
+        run_trials(_configs(), workers=1, run=killed, journal=journal)
+    assert len(journal.read_text().splitlines()) == 4
+    rest = _Stop()
+    resumed = run_trials(_configs(), workers=1, run=rest, journal=journal, resume=True)
+    assert rest.calls == [("a", 4), ("a", 5)]
+    assert _same(resumed, whole)
+    assert resumed[0]["pair"] == [0, "a"]  # every result has been through JSON, fresh or read back
+    again = _Stop()
+    assert _same(run_trials(_configs(), workers=1, run=again, journal=journal, resume=True), whole)
+    assert again.calls == []
+
+
+def test_a_resumed_sweep_on_the_process_pool(tmp_path):
+    journal = tmp_path / "trials.jsonl"
+    first = run_trials(_configs(4), workers=2, run=_echo, journal=journal)
+    lines = journal.read_text().splitlines(keepends=True)
+    journal.write_text("".join(lines[:2]))
+    assert _same(run_trials(_configs(4), workers=2, run=_echo, journal=journal, resume=True), first)
+    assert len(journal.read_text().splitlines()) == 4
+
+
+def test_a_journal_cut_in_the_middle_of_a_line(tmp_path):
+    journal = tmp_path / "trials.jsonl"
+    whole = run_trials(_configs(3), workers=1, run=_echo, journal=journal)
+    text = journal.read_text()
+    journal.write_text(text[: len(text) - 25])  # the kill came while the last line was written
+    rest = _Stop()
+    assert _same(run_trials(_configs(3), workers=1, run=rest, journal=journal, resume=True), whole)
+    assert rest.calls == [("a", 2)]
+    assert len(journal.read_text().splitlines()) == 3
+
+
+def test_crashed_interrupted_and_error_trials_run_again_on_resume(tmp_path):
+    journal = tmp_path / "trials.jsonl"
+    statuses = {0: "crashed", 1: "interrupted", 2: "error", 3: "failed"}
+    run_trials(_configs(4), workers=2, run=_status_of, journal=journal)  # (interrupted would end a serial sweep)
+    rest = _Stop()
+    run_trials(_configs(4), workers=1, run=rest, journal=journal, resume=True)
+    assert sorted(rest.calls) == [("a", k) for k, s in statuses.items() if s != "failed"]
+
+
+def _status_of(config) -> dict:
+    return {"status": {0: "crashed", 1: "interrupted", 2: "error", 3: "failed"}[config[1]]}
+
+
+def test_a_resume_with_other_settings_is_refused_naming_them(tmp_path):
+    journal = tmp_path / "trials.jsonl"
+    configs = [wander_config(tmp_path, params={"robots": 2}, seed=s, duration=2.0, run_id=f"s{s}") for s in (1, 2)]
+    run_trials(configs, workers=1, run=lambda c: {"status": "completed"}, journal=journal)
+    moved = [wander_config(tmp_path / "elsewhere", params={"robots": 2}, seed=s, duration=2.0, run_id=f"s{s}")
+             for s in (1, 2)]  # another output folder is the same trial
+    run_trials(moved, workers=1, run=lambda c: {"status": "completed"}, journal=journal, resume=True)
+    other = [wander_config(tmp_path, params={"robots": 3}, seed=s, duration=2.0, run_id=f"s{s}") for s in (1, 2)]
+    with pytest.raises(JournalError, match=r"trial 0 \(wander seed 1 s1\) was run with params.robots=2 there, 3 now"):
+        run_trials(other, workers=1, run=lambda c: {"status": "completed"}, journal=journal, resume=True)
+    with pytest.raises(JournalError, match="not in this study, which has 1 trials"):
+        run_trials(configs[:1], workers=1, run=lambda c: {"status": "completed"}, journal=journal, resume=True)
+
+
+def test_an_existing_journal_is_not_overwritten_without_resume(tmp_path):
+    journal = tmp_path / "trials.jsonl"
+    run_trials(_configs(2), workers=1, run=_echo, journal=journal)
+    before = journal.read_bytes()
+    with pytest.raises(JournalError, match=f"--resume {tmp_path} to continue it, or another --out"):
+        run_trials(_configs(2), workers=1, run=_echo, journal=journal)
+    assert journal.read_bytes() == before
+    with pytest.raises(JournalError, match="nothing to resume"):
+        run_trials(_configs(2), workers=1, run=_echo, journal=tmp_path / "none" / "trials.jsonl", resume=True)

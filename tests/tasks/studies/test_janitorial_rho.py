@@ -52,6 +52,11 @@ def fake_study(tmp_path, time_of) -> tuple[jr.JanitorialRhoStudy, str, list[dict
     return study, (out / "report.md").read_text(), rows
 
 
+def ci(low: float, high: float) -> str:
+    """How the report gives the 95 % confidence interval of a paired ratio of mean times."""
+    return f"[95 % CI of the paired ratio: x{low:.2f} to x{high:.2f}]"
+
+
 FACTOR = {0.0: 1.0, 0.1: 0.78, 0.5: 0.78 * 0.9, 2.0: 0.78 * 0.9 * 1.01}
 
 
@@ -63,10 +68,12 @@ def test_report_reproduces_thesis_like_times(tmp_path):
     assert "| 0 | 10 | 10 | 545 | 30 | - | - | - |" in text
     assert "| rho = 0 (no messages): the mission still completes | every run completed, mean 438 time units | " \
            "10/10 completed, mean 545 s | - | - | yes |" in text
-    assert "| rho 0 -> 0.1: mean mission time | about 22 % less time | x0.78 (-22 %) | 10 | 0.002 | yes |" in text
-    assert "| rho 0.1 -> 0.5: mean mission time | a further 10 % less | x0.90 (-10 %) | 10 | 0.002 | yes |" in text
-    assert "| rho 0.5 -> 2: mean mission time | \"not getting closer to the optimal\" | x1.01 (+1 %) | 10 | " \
+    assert f"| rho 0 -> 0.1: mean mission time | about 22 % less time | x0.78 (-22 %) {ci(0.78, 0.78)} | 10 | " \
            "0.002 | yes |" in text
+    assert f"| rho 0.1 -> 0.5: mean mission time | a further 10 % less | x0.90 (-10 %) {ci(0.9, 0.9)} | 10 | 0.002 | " \
+           "yes |" in text
+    assert "| rho 0.5 -> 2: mean mission time | \"not getting closer to the optimal\" | x1.01 (+1 %) " \
+           f"{ci(1.01, 1.01)} | 10 | 0.002 | yes |" in text
     table = [line for line in text.splitlines() if line.startswith("| ")]
     assert not any("biased" in line or "too few" in line or "not decided" in line for line in table)
 
@@ -95,9 +102,10 @@ def test_censored_runs_have_no_time_and_make_means_biased_or_undecided(tmp_path)
     assert "7/10 completed, mean 560 s (biased low) | - | - | partly |" in text
     step_01 = next(line for line in text.splitlines() if line.startswith("| rho 0 -> 0.1"))
     # 0.819 x the completed rho = 0 runs, but 0.80 x their (biased) mean; every pair lower: p = 2 / 2**7
-    assert "x0.80 (-20 %), biased: not every run completed | 7 | 0.016 | yes |" in step_01
+    assert f"x0.80 (-20 %) {ci(0.82, 0.82)}, biased: not every run completed | 7 | 0.016 | yes |" in step_01
     step_05 = next(line for line in text.splitlines() if line.startswith("| rho 0.1 -> 0.5"))
-    assert "| x0.90 (-10 %) | 10 |" in step_05 and step_05.endswith("| yes, not decided by this sample |")
+    assert f"| x0.90 (-10 %) {ci(0.79, 1.01)} | 10 |" in step_05
+    assert step_05.endswith("| yes, not decided by this sample |")
     step_2 = next(line for line in text.splitlines() if line.startswith("| rho 0.5 -> 2"))
     assert "| 3 |" in step_2 and step_2.endswith("| too few completed runs to decide |")
 
