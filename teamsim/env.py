@@ -31,6 +31,7 @@ from teamsim.config import ConfigError
 from teamsim.controllers.base import Command, Observation
 from teamsim.runner import mission_of, trial_config
 from teamsim.scenario import resolve
+from teamsim.tasks import MISSIONS
 from teamsim.world import World
 
 
@@ -83,8 +84,8 @@ class TeamEnv(ParallelEnv):
 
     def __init__(self, mission: str, *, scenario=None, settings=(), faults=(), seed: int | None = None,
                  duration: float | None = None, agents: list[str] | None = None):
-        if mission not in _missions():
-            raise ValueError(f"mission: unknown mission {mission!r}; known: {', '.join(_missions())}")
+        if mission not in MISSIONS:
+            raise ValueError(f"mission: unknown mission {mission!r}; known: {', '.join(MISSIONS)}")
         self._arguments = dict(scenario=scenario, settings=tuple(settings), faults=tuple(faults), duration=duration)
         self._seeds = np.random.default_rng(seed)
         self.mission = mission_of(mission)
@@ -256,13 +257,6 @@ class SingleRobotEnv(gymnasium.Env):
         observations, rewards, terminated, truncated, infos = self.team.step({self.agent: action})
         a = self.agent
         return observations[a], rewards[a], terminated[a], truncated[a], infos[a]
-
-
-@functools.cache
-def _missions() -> tuple[str, ...]:
-    from teamsim.tasks import MISSIONS  # noqa: PLC0415
-
-    return tuple(MISSIONS)
 
 
 def parallel_env(mission: str, **arguments) -> TeamEnv:
