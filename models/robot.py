@@ -5,6 +5,7 @@ they are prefixed with the robot's name (``red/left``), which is the robot's MJC
 """
 from __future__ import annotations
 
+import hashlib
 import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -31,13 +32,10 @@ def team_names(count: int) -> list[str]:
 def colour_of(name: str) -> tuple[float, float, float, float]:
     if name in TEAM_COLOURS:
         return TEAM_COLOURS[name]
-    hue = (hash_name(name) % 360) / 360.0  # stable pseudo-random hue for unnamed colours
+    # A stable pseudo-random hue for other names, spread round the wheel even for one-letter names.
+    hue = int.from_bytes(hashlib.sha256(name.encode()).digest()[:4], "big") / 2**32
     r, g, b = (0.5 + 0.4 * math.cos(2 * math.pi * (hue + k / 3)) for k in range(3))
     return (r, g, b, 1.0)
-
-
-def hash_name(name: str) -> int:
-    return sum((i + 1) * ord(c) for i, c in enumerate(name))
 
 
 @dataclass(frozen=True)

@@ -31,6 +31,11 @@ class Mission(Protocol):
     def outcome(self, world: Any) -> tuple[bool, dict]:
         """(completed, metrics) measured from the world at the end of the trial."""
 
+    # Optional, for missions whose robots take roles at run time (bounding overwatch elects leaders, Parker
+    # §6.3): ``fault_roles: dict[str, str]`` (role -> meaning) are the roles a fault may name as ``@ROLE``, and
+    # ``role_holder(world, role) -> str | None`` names the live robot holding one now (None: vacant; the fault
+    # then waits). The world asks when the fault is due (teamsim.faults).
+
 
 class ScenarioMission:
     """A mission whose worlds are scenarios (``teamsim.scenario``): ``scenario`` describes the world its

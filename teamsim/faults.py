@@ -7,6 +7,12 @@ arena, as Parker seized an R-2, §6.1.2), ``revive:red@120`` (switched on again 
 robot is put back where the mission says, else at its start). The world applies each fault at its time and
 records an event; a fault changes a robot's :class:`Health`, which the world consults when sensing and actuating
 (and the world moves a removed or revived robot and gives a revived one a fresh controller).
+
+A fault may strike a *role* instead of a named robot: ``@ROLE`` in place of ROBOT (``kill:@leader@300``,
+``kill:@leader:A@300``). Which robot holds a role is known only while the mission runs (bounding overwatch elects
+its leaders, Parker §6.3), so the world asks the mission (``role_holder(world, role)``) when the fault is due, and
+a role nobody holds then keeps the fault waiting until somebody does (docs/decisions.md, "Faults by run-time
+role"). The ``@`` keeps a role apart from a robot name, which may not contain it.
 """
 from __future__ import annotations
 
@@ -30,8 +36,12 @@ FAULT_OPTIONS: dict[str, dict[str, tuple]] = {
     "revive": {},
 }
 FAULT_KINDS = tuple(FAULT_OPTIONS)
-_SPEC = re.compile(r"^(?P<kind>[a-z-]+):(?P<robot>[A-Za-z0-9_-]+)@(?P<time>[^,]+)(?P<rest>(,[^,=]+=[^,]*)*)$")
+_SPEC = re.compile(r"^(?P<kind>[a-z-]+):(?P<robot>[A-Za-z0-9_-]+|@[A-Za-z0-9_-]+(:[A-Za-z0-9_-]+)?)@(?P<time>[^,]+)"
+                   r"(?P<rest>(,[^,=]+=[^,]*)*)$")
 SPEC_FORM = "KIND:ROBOT@SECONDS[,key=value...]"
+ROLE_MARK = "@"  # a target that starts with it is a role (``@leader``), resolved when the fault is due
+# A role's holder is a robot that is running: a role cannot bring a robot in or switch one on again.
+NOT_BY_ROLE = ("add-robot", "revive")
 
 
 @dataclass(frozen=True)
@@ -40,6 +50,11 @@ class Fault:
     robot: str
     time: float
     options: dict = field(default_factory=dict)
+
+    @property
+    def role(self) -> str | None:
+        """The role this fault strikes (``leader`` for ``@leader``), or None when it names a robot."""
+        return self.robot[len(ROLE_MARK):] if self.robot.startswith(ROLE_MARK) else None
 
     def describe(self) -> dict:
         described = {"kind": self.kind, "robot": self.robot, "time": self.time}
@@ -63,10 +78,15 @@ def parse_fault(spec: str) -> Fault:
     """Parse one ``--fault`` spec; raise ConfigError with a one-line reason."""
     match = _SPEC.match(spec.strip())
     if not match:
-        raise ConfigError(f"--fault {spec!r}: expected {SPEC_FORM}, e.g. kill:red@60")
+        raise ConfigError(f"--fault {spec!r}: expected {SPEC_FORM} (ROBOT: a robot's name, or @ROLE), e.g. "
+                          "kill:red@60")
     kind = match["kind"]
     if kind not in FAULT_OPTIONS:
         raise ConfigError(f"--fault {spec!r}: unknown kind {kind!r}; allowed: {', '.join(FAULT_KINDS)}")
+    if match["robot"].startswith(ROLE_MARK) and kind in NOT_BY_ROLE:
+        allowed = ", ".join(k for k in FAULT_KINDS if k not in NOT_BY_ROLE)
+        raise ConfigError(f"--fault {spec!r}: {kind} needs a robot's name, not a role; kinds a role "
+                          f"({match['robot']}) may take: {allowed}")
     try:
         time = float(match["time"])
     except ValueError:
@@ -112,3 +132,11 @@ def apply_fault(fault: Fault, health: Health, motor_names: tuple[str, ...]) -> N
         health.speed_factor *= fault.options["factor"]
     elif kind == "break-gripper":
         health.gripper_broken = True
+
+
+def role_refusal(mission: str, role: str, roles: dict) -> str:
+    """Why a fault may not name ``@role`` in ``mission`` (whose ``fault_roles`` are ``roles``), with what may be
+    named instead: one line."""
+    if not roles:
+        return f"{mission} has no roles a fault may name (@ROLE is for missions that elect them); name a robot"
+    return f"{mission} has no role {role!r}; allowed roles: {', '.join(ROLE_MARK + r for r in roles)}"

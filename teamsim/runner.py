@@ -196,6 +196,14 @@ def _run_without_physics(config: TrialConfig, mission) -> TrialResult:
     return TrialResult(summary["status"], run_dir, summary)
 
 
+def _as_struck(described: dict) -> dict:
+    """A fault as the timeline marks it: on the robot a fault by role struck, when it struck (a role that stayed
+    vacant is on nobody's row)."""
+    if "hit" not in described:
+        return described
+    return {**described, "robot": described["hit"], "time": described["hit_at"]}
+
+
 def run_trial(config: TrialConfig, seed: int | None = None, progress: bool | None = None) -> TrialResult:
     """Run one trial and write its outputs. ``seed`` overrides ``config.seed``. Bad configuration raises
     ConfigError before anything is written; everything after that ends in a saved summary."""
@@ -287,7 +295,7 @@ def run_trial(config: TrialConfig, seed: int | None = None, progress: bool | Non
         if recorder.times:
             keep("timeline.png", lambda: write_timeline(
                 run_dir / "timeline.png", recorder.times, recorder.behaviour_array(), recorder.robot_names,
-                [f.describe() for f in config.faults], motivation.series))
+                [_as_struck(f) for f in world.fault_report()], motivation.series))
         video_failure = video.close() if video is not None else None
         if video_failure:
             error = f"{error}; video: {video_failure}" if error else f"video: {video_failure}"
@@ -300,7 +308,7 @@ def run_trial(config: TrialConfig, seed: int | None = None, progress: bool | Non
                        sim_time_s=round(world.time, 6), wall_time_s=round(wall, 3),
                        real_time_factor=round(world.time / wall, 2) if wall > 0 else None,
                        metrics=metrics, robots=world.robot_summary(), final_state_sha256=state_digest(world),
-                       faults=[f.describe() for f in config.faults],
+                       faults=world.fault_report(),  # (a fault by role: whom it struck, and when)
                        outputs=_outputs(run_dir))
         keep("summary.json", lambda: write_json(run_dir / "summary.json", summary))
         if failed_writes:

@@ -33,7 +33,7 @@ import yaml
 
 from teamsim.config import (ConfigError, PositioningConfig, RadioConfig, Timing, TrialConfig, apply_setting,
                             check_value, setting, settable_keys, validate)
-from teamsim.faults import FAULT_KINDS, Fault, parse_fault
+from teamsim.faults import FAULT_KINDS, Fault, parse_fault, role_refusal
 from teamsim.models import ROBOT_BUILDERS, ROBOT_KINDS, build_robot
 from teamsim.models.arenas import OBSTACLE_RGBA, Bog, Box, add_bog, walled_room
 from teamsim.models.objects import BoxDims, PuckDims, box, place, place_puck
@@ -150,7 +150,8 @@ class RobotEntry:
 class FaultEntry:
     """A fault (``teamsim.faults``), as ``--fault KIND:ROBOT@TIME,key=value`` writes it."""
     kind: str = setting("kill", choices=FAULT_KINDS, meaning="what goes wrong")
-    robot: str = setting("", meaning="the robot it happens to")
+    robot: str = setting("", meaning="the robot it happens to, or @ROLE: whoever holds that role of the mission "
+                                     "when it is due (missions that elect roles)")
     time: float = setting(0.0, lo=0.0, hi=1e7, meaning="when, s")
     options: dict = field(default_factory=dict, metadata={"meaning": "the kind's options (`teamsim run --help`)"})
 
@@ -567,10 +568,11 @@ def _footprint(kind: str, options: tuple) -> tuple[float, float]:
     return model.footprint_radius, offset
 
 
-def check(scenario: Scenario, faults: list[Fault]) -> None:
+def check(scenario: Scenario, faults: list[Fault], roles: dict | None = None) -> None:
     """The physics of a scenario, before anything is compiled: sizes, robots clear of the walls, obstacles,
     objects and each other, objects inside the arena, IR counts that fit their robots, faults that name robots
-    of the team. ``faults`` is the whole schedule (the scenario's and the command line's)."""
+    of the team or roles of the mission (``roles``: its ``fault_roles``, resolved at run time). ``faults`` is the
+    whole schedule (the scenario's and the command line's)."""
     a = scenario.arena
     hx, hy = a.size[0] / 2, a.size[1] / 2
     inside = f"inside the {a.size[0]:g} x {a.size[1]:g} m arena"
@@ -623,6 +625,10 @@ def check(scenario: Scenario, faults: list[Fault]) -> None:
     team = ", ".join(scenario.robots)
     for k, fault in enumerate(faults):
         spec = f"faults[{k}] {fault.kind}:{fault.robot}@{fault.time:g}"
+        if fault.role is not None:
+            if fault.role not in (roles or {}):
+                raise ConfigError(f"{spec}: {role_refusal(scenario.mission or 'this mission', fault.role, roles)}")
+            continue
         robot = scenario.robots.get(fault.robot)
         if robot is None:
             extra = " (a newcomer needs its kind and pose in robots)" if fault.kind == "add-robot" else ""
@@ -684,7 +690,7 @@ def config_of(scenario: Scenario, mission, like: TrialConfig, extra_faults: list
     faults = [_fault(k, entry) for k, entry in enumerate(scenario.faults)] + list(extra_faults)
     if hasattr(mission, "fault_targets"):  # a mission may let faults name robots by role ("kill:planner@60")
         faults = mission.fault_targets(scenario, faults)
-    check(scenario, faults)
+    check(scenario, faults, getattr(mission, "fault_roles", {}))
     extra_check = getattr(mission, "check_scenario", None)
     if extra_check is not None:
         extra_check(scenario)

@@ -14,7 +14,7 @@ rangefinder casts against every geom and per-step sensing dominated the cost of 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import mujoco
 import numpy as np
@@ -22,7 +22,7 @@ import numpy as np
 from teamsim.config import ConfigError, TrialConfig
 from teamsim.controllers.base import Command, Observation
 from teamsim.controllers.skills.locomotion import make_locomotion
-from teamsim.faults import Fault, Health, apply_fault
+from teamsim.faults import Fault, Health, apply_fault, role_refusal
 from teamsim.models import ROBOT_BUILDERS, build_robot
 from teamsim.models.robot import RobotModel
 from teamsim.network import Delivery, Network, NetworkConfig
@@ -146,7 +146,11 @@ class World:
         self.bogs = list(scene.bogs)
         faults = list(scene.faults) + list(config.faults)  # the scenario's own, then the user's
         self.check_faults(faults)
-        self.faults = sorted(faults, key=lambda f: f.time)
+        self.schedule = faults
+        self._user_faults = len(scene.faults)  # schedule[_user_faults:] are config.faults
+        self.struck: list[tuple[str, float] | None] = [None] * len(faults)  # (robot, when) each fault struck
+        self._pending = sorted(range(len(faults)), key=lambda k: faults[k].time)  # indices into schedule
+        self._waiting: set[int] = set()  # role faults due whose role was vacant (their wait is logged once)
         self.xml = scene.arena.to_xml_string()
         try:
             self.model = mujoco.MjModel.from_xml_string(self.xml, scene.arena.get_assets())
@@ -169,26 +173,40 @@ class World:
 
     # -- set-up ---------------------------------------------------------------------------------------------
     def check_faults(self, faults: list[Fault]) -> None:
-        """Reject faults naming unknown robots or parts they lack, before anything runs."""
+        """Reject faults naming unknown robots or roles, or parts their robots lack, before anything runs. A role
+        may fall to any robot of the team, so a fault by role must suit every one of them."""
         joins = {f.robot: f.time for f in faults if f.kind == "add-robot"}
+        roles = getattr(self.mission, "fault_roles", {})
         for fault in faults:
-            robot = self.robots.get(fault.robot)
             spec = f"--fault {fault.kind}:{fault.robot}@{fault.time:g}"
             if fault.kind == "add-robot":
                 continue  # checked as the team is built
+            if fault.role is not None:
+                if fault.role not in roles:
+                    raise ConfigError(f"{spec}: {role_refusal(self.mission.name, fault.role, roles)}")
+                for robot in self.robots.values():
+                    if not robot.dormant:
+                        self._check_parts(fault, robot, f"{spec} (the role may fall to {robot.name})")
+                continue
             if fault.robot in joins and fault.time < joins[fault.robot]:
                 raise ConfigError(f"{spec}: {fault.robot} joins at {joins[fault.robot]:g} s (add-robot); its faults "
                                   f"must come at or after that")
+            robot = self.robots.get(fault.robot)
             if robot is None:
                 raise ConfigError(f"{spec}: no robot {fault.robot!r}; team: {', '.join(self.robots)}")
-            if fault.kind == "break-motor" and fault.options.get("motor") not in (None, *robot.model.motors):
-                raise ConfigError(f"{spec}: motor must be one of {', '.join(robot.model.motors)}")
-            if fault.kind == "break-gripper" and not robot.model.effectors:
-                raise ConfigError(f"{spec}: a {robot.model.kind} robot has no gripper")
-            for prefix in fault.options.get("sensors", "").split("+") if fault.kind == "blind-ir" else ():
-                if not any(name.startswith(prefix) for name in robot.model.ir_sensors):
-                    raise ConfigError(f"{spec}: sensors: no IR sensor of {robot.name} starts with {prefix!r}; "
-                                      f"its sensors: {', '.join(robot.model.ir_sensors)}")
+            self._check_parts(fault, robot, spec)
+
+    @staticmethod
+    def _check_parts(fault: Fault, robot: Robot, spec: str) -> None:
+        """The parts a fault's options name (a motor, IR sensors, the gripper) exist on ``robot``."""
+        if fault.kind == "break-motor" and fault.options.get("motor") not in (None, *robot.model.motors):
+            raise ConfigError(f"{spec}: motor must be one of {', '.join(robot.model.motors)}")
+        if fault.kind == "break-gripper" and not robot.model.effectors:
+            raise ConfigError(f"{spec}: a {robot.model.kind} robot has no gripper")
+        for prefix in fault.options.get("sensors", "").split("+") if fault.kind == "blind-ir" else ():
+            if not any(name.startswith(prefix) for name in robot.model.ir_sensors):
+                raise ConfigError(f"{spec}: sensors: no IR sensor of {robot.name} starts with {prefix!r}; "
+                                  f"its sensors: {', '.join(robot.model.ir_sensors)}")
 
     def _index_model(self) -> None:
         m = self.model
@@ -269,8 +287,12 @@ class World:
         team order. Lazily: :meth:`tick` acts on each robot before the next one's observation is built."""
         self.check_stable()
         now = self.time
-        while self.faults and self.faults[0].time <= now + 1e-9:
-            self._apply(self.faults.pop(0), now)
+        waiting = []
+        while self._pending and self.schedule[self._pending[0]].time <= now + 1e-9:
+            k = self._pending.pop(0)
+            if not self._strike(k, now):
+                waiting.append(k)
+        self._pending[:0] = waiting  # (due already, so still first in time order)
         m, d = self.model, self.data
         mujoco.mj_kinematics(m, d)
         m.opt.disableflags &= ~_SENSOR_STAGE
@@ -427,7 +449,37 @@ class World:
         hit = owners[relevant].ravel()
         return np.unique(hit[hit >= 0])
 
-    def _apply(self, fault: Fault, now: float) -> None:
+    def _strike(self, k: int, now: float) -> bool:
+        """Apply fault ``k`` of the schedule, which is due; False if it names a role that nobody holds now (it
+        waits for a holder: docs/decisions.md, "Faults by run-time role")."""
+        fault, by_role = self.schedule[k], None
+        if fault.role is not None:
+            target = self.mission.role_holder(self, fault.role)
+            if target is not None and target not in self.robots:
+                raise ValueError(f"{self.mission.name}.role_holder({fault.role!r}) gave {target!r}, not a robot")
+            if target is None or not self.robots[target].active:  # a role held by the dead is vacant
+                if k not in self._waiting:
+                    self._waiting.add(k)
+                    self.record({"t": round(now, 6), "event": "fault-waiting", **fault.describe(),
+                                 "reason": f"no robot holds the role {fault.role!r}: the fault waits for one"})
+                return False
+            by_role, fault = fault.robot, replace(fault, robot=target)
+        self._apply(fault, now, by_role)
+        self.struck[k] = (fault.robot, round(now, 6))
+        return True
+
+    def fault_report(self) -> list[dict]:
+        """The user's faults (``config.faults``) as scheduled; a fault by role also says whom it struck and when
+        (``hit``, ``hit_at``; None while its role stayed vacant)."""
+        report = []
+        for fault, struck in zip(self.schedule[self._user_faults:], self.struck[self._user_faults:]):
+            described = fault.describe()
+            if fault.role is not None:
+                described["hit"], described["hit_at"] = struck if struck is not None else (None, None)
+            report.append(described)
+        return report
+
+    def _apply(self, fault: Fault, now: float, by_role: str | None = None) -> None:
         robot = self.robots[fault.robot]
         if fault.kind == "add-robot":
             self._place(robot)
@@ -448,7 +500,8 @@ class World:
             if fault.kind == "remove":
                 self._move(robot, (PARKING_X + 3.0 * self._index_of[robot.name], 0.0, 0.0))
         self.radio.set_enabled(robot.name, robot.health.radio_on and not robot.dormant)
-        self.record({"t": round(now, 6), "event": "fault", **fault.describe()})
+        self.record({"t": round(now, 6), "event": "fault", **fault.describe(),
+                     **({"target": by_role} if by_role is not None else {})})
 
     def _unpower(self, *actuators: int) -> None:
         """A broken motor goes limp: its actuator no longer produces force."""

@@ -42,6 +42,7 @@ GROUPS = ("A", "B")  # A bounds first (the thesis's "first team")
 JOIN, EMERGE, LEAD, FOLLOW, OVERWATCH = "join-group", "emerge-leader", "lead-to-waypoint", "follow-leader", "overwatch"
 SETS = (JOIN, EMERGE, LEAD, FOLLOW, OVERWATCH)  # priority order (the §3.6 tie-break)
 LONG = 1e6  # s: psi and lambda of sets that are never handed over or given up
+PROGRESS = 0.5  # m a lagging follower must gain on its slot for its leader to keep waiting (OverwatchParams.patience)
 
 
 @dataclass(frozen=True)
@@ -64,6 +65,10 @@ class OverwatchParams:
     move_speed: float = setting(0.35, lo=0.05, hi=1.0, meaning="m/s to a gathering slot")
     lag: float = setting(4.0, lo=0.5, hi=50.0, meaning="m a follower may lag its slot before the leader slows; "
                                                        "at twice this the leader waits")
+    patience: float = setting(30.0, lo=1.0, hi=1e4, meaning="s a leader waits for a member that gets no nearer "
+                                                            "(by 0.5 m) to the gathering point, or slows or waits "
+                                                            "for a follower lagging beyond lag that gets no nearer "
+                                                            "its slot; then it goes on without it")
     leader_delay: float = setting(1.0, lo=0.01, hi=600.0, meaning="theta / delta_fast of emerge-leader, s, for "
                                                                   "the robot of priority 0")
     leader_step: float = setting(0.3, lo=0.0, hi=600.0, meaning="s added to leader_delay per priority rank: the "
@@ -348,6 +353,8 @@ class OverwatchRobot:
         self.joins: list[tuple[str, float]] = []  # (group, when) for each decision, switches included
         self.leaderships: list[Record] = []
         self.bound_log: list[Record] = []
+        self.lagging: dict[str, tuple[float, float]] = {}  # follower -> (since when it gained no ground, its lag)
+        self.arriving: dict[str, tuple[float, float]] = {}  # member not yet gathered -> (since, its distance)
         fast = {s: MotivationRates(delta_fast=1 / params.set_delay, delta_slow=1 / (10 * params.set_delay),
                                    phi=LONG, psi=LONG, lam=LONG) for s in SETS}
         fast[JOIN] = replace(fast[JOIN], delta_fast=20.0, delta_slow=2.0)  # all activate it at the start
@@ -380,7 +387,27 @@ class OverwatchRobot:
 
     def may_lead(self) -> bool:
         return (self.k.me.visited and self.is_leader and self.k.turn() == self.group
-                and (self.k.me.leading is not None or self.k.group_gathered(self.group)))
+                and (self.k.me.leading is not None or self._gathered()))
+
+    def _gathered(self) -> bool:
+        """My group has collected (§6.3: a bound starts "as soon as its team has collected"): every live member
+        heard has visited our gathering point, but for one that has got no nearer to it (by ``PROGRESS``, by its
+        broadcasts) for ``patience`` seconds: wedged among robots round the other group's point, say, it is not
+        waited for (as :meth:`_lag`; docs/bounding-overwatch.md)."""
+        k, p = self.k, self.params
+        point = np.array(self.gather[self.group])
+        for name, m in k.present().items():
+            if m.group != self.group or m.visited:
+                self.arriving.pop(name, None)
+                continue
+            if m.at is None:
+                return False
+            away = float(np.hypot(*(point - np.array(m.at[:2]))))
+            if name not in self.arriving or away < self.arriving[name][1] - PROGRESS:
+                self.arriving[name] = (k.now, away)  # (just heard, or it gains ground)
+            if k.now - self.arriving[name][0] <= p.patience:
+                return False
+        return k.me.visited
 
     def _leader_leading(self) -> Member | None:
         leader = self.k.leader(self.group) if self.group is not None else None
@@ -483,6 +510,7 @@ class OverwatchRobot:
         if me.leading != bound:
             me.leading = bound
             self.bound_log.append(Record(self.group, self.name, obs.time, bound=bound))
+            self.lagging.clear()  # each bound waits afresh for its laggards
         target = np.array(self.route[bound])
         offset = target - self.pose[:2]
         distance = float(np.hypot(*offset))
@@ -490,18 +518,30 @@ class OverwatchRobot:
             self.bound_log[-1].end = obs.time
             self.k.bounds, me.leading = bound + 1, None
             return Command()
-        lag = self._lag()
+        lag = self._lag(obs.time)
         slow = float(np.clip((2 * p.lag - lag) / p.lag, 0.0, 1.0))
         v, w = self.drive(obs, self.pose, offset, p.lead_speed * slow * min(1.0, distance / 1.0 + 0.3))
         return Command(v=v, omega=w)
 
-    def _lag(self) -> float:
-        """How far the farthest live follower is from its wedge slot, by their broadcasts."""
-        worst = 0.0
+    def _lag(self, now: float) -> float:
+        """How far the farthest live follower the leader still waits for is from its wedge slot, by their
+        broadcasts. A follower lagging beyond ``lag`` that has got no nearer (by ``PROGRESS``) for ``patience``
+        seconds is not waited for (a broken motor, a robot wedged for good: the group must not wait forever,
+        docs/bounding-overwatch.md) until it comes within ``lag`` again or gains ground."""
+        p, worst = self.params, 0.0
         for rank, name in enumerate(self.k.followers(self.group, self.name)):
             m = self.k.member(name)
-            if m.at is not None:
-                worst = max(worst, float(np.hypot(*(self._slot(rank, self.pose) - np.array(m.at[:2])))))
+            if m.at is None:
+                continue
+            lag = float(np.hypot(*(self._slot(rank, self.pose) - np.array(m.at[:2]))))
+            best = self.lagging.get(name, (now, lag))[1]
+            if lag <= p.lag:
+                self.lagging.pop(name, None)
+            elif lag < best - PROGRESS or name not in self.lagging:
+                self.lagging[name] = (now, lag)  # it gains ground (or just fell behind): wait for it
+            if name in self.lagging and now - self.lagging[name][0] > p.patience:
+                continue
+            worst = max(worst, lag)
         return worst
 
     def _slot(self, rank: int, leader_pose) -> np.ndarray:

@@ -9,7 +9,8 @@ are applicable ("every robot thinks the opposite end was just pushed").
 
 - R-2 (:class:`R2BoxPusher`, Fig. 6-1): push-left and push-right (:class:`PushEnd`), symmetric. An activation
   acquires the end if the robot is not already there (back off, turn along the box, follow it with the side IR
-  to its end, back up, turn into the box), closes in with the fingertip IR, pushes for ``push_time`` keeping
+  to its end, back up, turn into the box; something in its way along the box, it turns in where it got to),
+  closes in until contact (fingertip IR, bumper, or the wheels crawling), pushes for ``push_time`` keeping
   square to the face with the fingertip IR (holding its heading by the compass while only one fingertip sees the
   face), backs off a little, and records the push complete. Its own end's
   set comes first in its priority order (the tie-break of §3.6: both sets cross theta together at the start).
@@ -86,6 +87,10 @@ class BoxPushParams:
     end_inset: float = 0.15  # m backed up from there: the robot pushes this far in from the end
     contact_range: float = 0.03  # m: a fingertip reading nearer than this is contact
     approach_timeout: float = 4.0  # s closing in before pushing anyway
+    # Contact felt through the wheels (shaft encoders, §2.2.1): driving into the heavy box the R-2 crawls (measured
+    # 0.01-0.05 m/s against 0.3 asked), closing in freely it is past this speed within 0.2 s (0.5 m/s^2).
+    stall_speed: float = 0.1  # m/s
+    stall_time: float = 0.6  # s closing in before a crawl counts as contact
     square_gain: float = 2.0  # rad/s per m of difference between the two fingertip readings
     whisker_gain: float = 0.02  # rad/s per N of difference between the two whiskers' contact forces
     whisker_timeout: float = 8.0  # s Genghis-II walks towards the box before its push time runs without a touch
@@ -93,6 +98,11 @@ class BoxPushParams:
     go_home_delay: float = 2.0  # s: theta / delta_fast_GH
     release_time: float = 0.3  # s backing off after a push, so the box can turn freely under the other end
     follow_limit: float = 2.5  # m of following without finding the end: give the acquisition up and push here
+    # Something in the way along the box (a robot killed at the end being acquired): a fingertip, which looks along
+    # the box while following it and never sees the face there (0.6 m off along the ray), reads it this near.
+    block_range: float = 0.08  # m
+    block_backoff: float = 0.08  # m backed up from it before turning into the box, clear of it while turning
+    block_wait: float = 40.0  # s held still first, a teammate heard: longer than phi (r2_patience, 30 s)
 
     def rates(self, delta_fast_delay: float, patience: float, teammates: dict[str, float]) -> MotivationRates:
         """One set's rates: theta = 1, delta_slow = 1 / patience for every teammate (its kind's patience)."""
@@ -170,6 +180,7 @@ class PushEnd:
     def restart(self) -> None:
         self.state, self.since, self.mark = "start", None, None
         self.seen, self.lost_at = False, None  # the side IR has seen the face; where it lost it
+        self.blocked_since = None  # since when something has been in the way while following
 
     def __call__(self, obs: Observation) -> Command:
         if self.since is None:
@@ -207,8 +218,24 @@ class PushEnd:
 
     def _follow(self, obs: Observation) -> Command:
         """Drive along the face with it on the side away from the end (on the right going left), holding
-        ``follow_distance`` on that side's front IR, until that IR has lost the face for ``end_overrun``."""
+        ``follow_distance`` on that side's front IR, until that IR has lost the face for ``end_overrun``; or until
+        a fingertip sees something in the way within ``block_range``. Then, with no teammate heard within tau, push
+        the end from as near it as the robot got (§6.1.1 "push a little on the right end"): a teammate killed at
+        its end stands there, and driving on into it wedged the survivor for lambda (60 s) every time it came for
+        that end (kill:green@124.4, seed 0). With a teammate heard, the robot in the way may be that teammate,
+        pushing from nearer the middle than the end: first hold still for ``block_wait``, longer than phi, so the
+        way can clear or the teammate's impatience take this end over (taking the end at once, a revived R-2 and
+        the survivor pushed the same half of the box and turned it 90 degrees, kill:red@100.5 revive:red@219.7,
+        seed 3); only then push from here (holding still for good, two R-2s met head-on, each waiting for the
+        other, until lambda, again and again: radio-off:green@177.4 radio-on:green@242.4, seed 2)."""
         p = self.params
+        if min(obs.ir_range[self.tips]) < p.block_range:
+            if self.blocked_since is None:
+                self.blocked_since = obs.time
+            if obs.robots_present and obs.time - self.blocked_since < p.block_wait:
+                return self.drive()
+            return self._go("clear", obs)
+        self.blocked_since = None
         side = OPPOSITE[self.end]
         reading = obs.ir_range[self.side_ir[side]]
         if math.isfinite(reading):
@@ -235,6 +262,12 @@ class PushEnd:
             return self._go("turn_in", obs)
         return self.drive(-self.params.drive.back_speed)
 
+    def _clear(self, obs: Observation) -> Command:
+        """Blocked while following: back up ``block_backoff`` along the box, then turn into it here."""
+        if self._moved() >= self.params.block_backoff:
+            return self._go("turn_in", obs)
+        return self.drive(-self.params.drive.back_speed)
+
     def _turn_in(self, obs: Observation) -> Command:
         omega = turn_to(self.estimate.pose, self.station.heading, self.params.drive, tolerance=0.05)
         if omega is not None:
@@ -255,10 +288,16 @@ class PushEnd:
         return float(np.clip(self.params.drive.turn_gain * error, -0.3, 0.3))
 
     def _approach(self, obs: Observation) -> Command:
+        """Close in until contact: a fingertip reads it, the front bumper feels it, or (the fingertips blinded)
+        the wheels crawl against the box; else push after ``approach_timeout`` anyway. (Blinded fingertips once
+        left only the timeout: each push drove into the box for 6 s where the other robot's drove 2 s, and the
+        box turned 90 degrees, blind-ir:green@119.8, seed 0.)"""
         p = self.params
+        closing = obs.time - self.mark[0]
         contact = min(obs.ir_range[self.tips]) < p.contact_range
-        if contact or obs.touch.get("bump_front", 0.0) >= p.drive.bump_force or \
-                obs.time - self.mark[0] >= p.approach_timeout:
+        crawling = obs.velocity is not None and closing >= p.stall_time and obs.velocity[0] < p.stall_speed
+        if contact or crawling or obs.touch.get("bump_front", 0.0) >= p.drive.bump_force or \
+                closing >= p.approach_timeout:
             return self._go("push", obs)
         return self.drive(p.push_speed, self.square(obs))
 
@@ -393,19 +432,29 @@ class GoHome:
 
 class GenghisBoxPusher:
     """Genghis-II's controller (Fig. 6-2): ALLIANCE over push (its end) and go-home. A teammate is pushing the
-    opposite end while it was heard announcing that end's task within tau."""
+    opposite end while it was heard announcing that end's task within tau.
 
-    def __init__(self, robot: RobotModel, end: str, params: BoxPushParams, alliance: AllianceParams = AllianceParams()):
+    ``waiting``: it was set down behind a teammate already at its end (add-robot to a full team). Until its first
+    push it announces nothing between pushes (it is not at the end, so it claims no end), and news of a teammate's
+    newer push at its end takes its push's feedback down for a tick (``news_at_end``): a new episode (§3.6), so the
+    teammate seen pushing restarts its patience phi. With both, a Genghis-II added behind a working R-2 waits; it
+    walks into the box once that R-2 falls silent for tau (killed or removed). Without them the two slowed each
+    other by their standing claims until Genghis-II's phi (30 s) ran out, and it walked into the R-2's back for
+    the rest of the run, the R-2 never pushing again (add-robot:newcomer@40.1,kind=genghis2, seed 0)."""
+
+    def __init__(self, robot: RobotModel, end: str, params: BoxPushParams, alliance: AllianceParams = AllianceParams(),
+                 waiting: bool = False):
         self.knowledge = PushKnowledge()
         self.end, self.tau = end, alliance.tau
+        self.waiting, self.news_at_end = waiting, False
         self.heard: dict[str, tuple[str | None, float]] = {}  # teammate -> (announced task, when)
         self.push = GenghisPush(robot, end, self.knowledge, params)
         self.home = GoHome(params, robot.limits.v_max, robot.limits.omega_max)
         self.sets = {self.push.name: self.push, GO_HOME: self.home}
         rates = params.rates(params.genghis_push_delay, params.r2_patience, {})  # (phi: an R-2 pushing its end)
         definitions = [
-            BehaviourSetDefinition(self.push.name, lambda obs: self.opposite_pushed(obs) and not self.push.done,
-                                   self.push, rates=rates),
+            BehaviourSetDefinition(self.push.name, lambda obs: self.opposite_pushed(obs) and not self.push.done
+                                   and not self.news_at_end and not self.listening(obs), self.push, rates=rates),
             BehaviourSetDefinition(GO_HOME, lambda obs: self.nobody_pushes(obs), self.home,
                                    rates=params.rates(params.go_home_delay, params.r2_patience, {}))]
         self.alliance = AllianceController(robot.name, definitions, alliance)
@@ -416,6 +465,12 @@ class GenghisBoxPusher:
     @property
     def pushes(self) -> list:
         return self.knowledge.pushes
+
+    def listening(self, obs: Observation) -> bool:
+        """Waiting behind a teammate, it has not yet listened for tau: it may not have heard that teammate, and
+        would take the end over at delta_fast (it did 1.5 s after joining, before green's radio slot came round,
+        add-robot:newcomer@188,kind=genghis2, seed 3)."""
+        return self.waiting and obs.time - self.on_since < self.tau
 
     def opposite_pushed(self, obs: Observation) -> bool:
         task = push_task(OPPOSITE[self.end])
@@ -429,11 +484,16 @@ class GenghisBoxPusher:
         return obs.time - self.on_since >= self.tau and not self.opposite_pushed(obs)
 
     def __call__(self, obs: Observation) -> Command:
+        pushed_here = self.knowledge.pushed_at[self.end]
         for message in obs.inbox:
             self.knowledge.hear(message.payload)
             self.heard[message.sender] = (announced_task(message.payload), obs.time)
+        # (only while waiting: at its own end, news of another's push there comes only from a robot it replaced)
+        self.news_at_end = self.waiting and self.knowledge.pushed_at[self.end] > pushed_here
         if obs.pose is None:
             return Command(behaviour=IDLE)
+        if self.on_since is None:
+            self.on_since = obs.time
         self.home.place(obs.pose)
         command = self.alliance(obs)
         if command.behaviour != self.active:
@@ -442,5 +502,7 @@ class GenghisBoxPusher:
             self.active = command.behaviour
             if self.active == GO_HOME:
                 self.went_home_at = obs.time
-        return announce(command, push_task(self.end), self.knowledge)
+        if self.waiting and self.push.done:
+            self.waiting = False  # it has pushed: it stands at its end now
+        return announce(command, None if self.waiting else push_task(self.end), self.knowledge)
 

@@ -14,7 +14,8 @@ empty), built from its own sensing and from teammates' broadcasts. The behaviour
   the fingertip IR, zero in, grasp and lift, carry to the goal, lower and release. Its feedback falls for one
   control period after each delivery (the load is moved), so the robot chooses afresh: that is when
   report-progress, if due, can win (ch.5: "the only time a robot tries to initiate the report-progress task is
-  after it has completed the transport of a spill object").
+  after it has completed the transport of a spill object"). A report that falls due while the robot sweeps the
+  spill in vain wins too: on an exhausted spill it would otherwise never come (:attr:`MoveSpill.searching_in_vain`).
 - report-progress (Fig. 3-8, :class:`ReportProgress`): applicable when a report is due (``report_interval``
   since the last report this robot knows of) and it has delivered since. It drives to the entrance and reports,
   by radio, which satisfies its teammates.
@@ -76,6 +77,9 @@ class CleanupParams:
     wander_patience: float = 3.0
     wander_sidestep: float = 0.5
     wander_sidesteps: int = 2
+    # m: blocked further than this along the leg from where it was first blocked, what blocks it has moved (a
+    # teammate), and the sidesteps count afresh: a wall is met at the same place (docs/decisions.md, "Wander find")
+    wall_stays: float = 0.2
     spill_vicinity: float = 1.0  # m from the believed spill centre where sweeping starts
     spill_radius: float = 0.6  # m: sweep lines pass within this of the believed spill centre
     sweep_overshoot: float = 0.6  # m a sweep line runs past its random point
@@ -309,8 +313,9 @@ class FindWander(ExtentTracker):
     it (``wander_leg`` s of driving: more than the room is long), so time lost to teammates in the way does not
     cut a leg short and put the goal short of the goal zone (measured: three robots wandering from the entrance
     at once, radio off). A leg also ends at a wall: blocked for ``wander_patience`` it sidesteps to its right and
-    carries on, up to ``wander_sidesteps`` times; blocked once more, what is ahead is the room's extent. A robot
-    in the way is passed, a wall stays. No leg lasts more than ``wander_leg_limit`` s."""
+    carries on, up to ``wander_sidesteps`` times; blocked once more at the same place along the leg, what is ahead
+    is the room's extent. A robot in the way is passed or moves on, a wall stays. No leg lasts more than
+    ``wander_leg_limit`` s."""
     name = WANDER
     HEADINGS = (math.pi, math.pi / 2, 0.0, -math.pi / 2)
 
@@ -328,6 +333,7 @@ class FindWander(ExtentTracker):
         self.sidesteps = 0
         self.sidestep_from: np.ndarray | None = None  # where the current sidestep began
         self.blocked_since: float | None = None
+        self.wall_at = 0.0  # how far along the leg's heading it was first blocked (since the sidesteps began)
 
     def next_leg(self, now: float) -> None:
         self.leg += 1
@@ -358,6 +364,11 @@ class FindWander(ExtentTracker):
         if self.blocked_since is None:
             self.blocked_since = obs.time
         if obs.time - self.blocked_since >= p.wander_patience:
+            along = float(np.dot(self.estimate.pose[:2], (math.cos(heading), math.sin(heading))))
+            if self.sidesteps and abs(along - self.wall_at) > p.wall_stays:
+                self.sidesteps = 0  # not where it was blocked before: that was a teammate, which moved on
+            if self.sidesteps == 0:
+                self.wall_at = along
             if self.sidesteps < p.wander_sidesteps:
                 self.sidesteps += 1
                 self.sidestep_from, self.blocked_since = self.estimate.pose[:2].copy(), None
@@ -399,6 +410,12 @@ class MoveSpill(SetController):
     def __call__(self, obs: Observation) -> Command:
         handler = getattr(self, f"_{self.state}")
         return handler(obs)
+
+    @property
+    def searching_in_vain(self) -> bool:
+        """Sweeping the spill with no load, after a line that found nothing: a report that falls due now wins
+        (docs/decisions.md, "A due report interrupts a fruitless search")."""
+        return self.state in ("to_spill", "sweep") and self.empty_lines > 0
 
     def _to_spill(self, obs: Observation) -> Command:
         command = self.go(obs, self._search_centre(), self.params.spill_vicinity)
@@ -585,11 +602,12 @@ class CleanupRobot:
         avoid = AvoidObstacles(robot.ir_sensors, robot.ir_bearings, bumpers, rng, params.drive)
         common = (self.knowledge, self.estimate, avoid, params)
         k = self.knowledge
+        move = MoveSpill(robot, rng, *common)
         sets = [(METHODICAL, FIND, FindMethodical(robot, *common), lambda obs: not k.located)] if methodical else []
         sets += [(WANDER, FIND, FindWander(robot, *common), lambda obs: not k.located),
                  (REPORT, REPORT, ReportProgress(*common), lambda obs: k.report_due(obs.time)),
-                 (MOVE, MOVE, MoveSpill(robot, rng, *common),
-                  lambda obs: k.located and not k.spill_empty(obs.time) and not k.just_delivered)]
+                 (MOVE, MOVE, move, lambda obs: k.located and not k.spill_empty(obs.time) and not k.just_delivered
+                  and not (k.report_due(obs.time) and move.searching_in_vain))]
         self.sets = {name: controller for name, _, controller, _ in sets}
         definitions = [BehaviourSetDefinition(name, applicable, controller, task=task, rates=RATES[name])
                        for name, task, controller, applicable in sets]

@@ -20,8 +20,10 @@ Every follower drives at its place with the tracked reference's speed fed forwar
 ``formation`` signal: relative poses with the positioning model's noise) and tracked with an alpha-beta filter in
 the world frame of the robot's own pose estimate. The leader slows while a neighbour it senses is far from its
 place by the strategy in use. Every robot bends its way round near IR readings (:func:`swerve`), and the robots of
-a crossing team give way (:class:`Crossing`). The thesis gives no control laws: docs/decisions.md, "Keeping
-formation".
+a crossing team give way (:class:`Crossing`). A robot that has failed (ALLIANCE's tau, spec §1.4:
+:meth:`FormationRobot.judge`) leaves its place empty: its neighbours re-link past it, and if it led, the living
+robot nearest its place takes over follow-route along its own lane (:class:`Line`, :meth:`KeepFormation.take_lead`).
+The thesis gives no control laws: docs/decisions.md, "Keeping formation".
 """
 from __future__ import annotations
 
@@ -62,6 +64,10 @@ class KeepFormationParams:
     next_leg: float = 1.0  # m: within this of its waypoint, the leader counts as turning onto the next leg (IV)
     give_way: float = 0.5  # m: a crossing robot stops while its front IR sees something nearer than this
     give_way_for: float = 15.0  # s: ... for at most this long
+    lost_after: float = 3.0  # s: a teammate not sensed for this long is out of sight (its track is dropped)
+    dead_after: float = 10.0  # s: a teammate silent on the radio and sensed standing this long has failed
+    still_move: float = 0.5  # m: a tracked teammate moving less than this from where it stood is standing
+    back_move: float = 2.0  # m: a failed teammate seen this far from where it failed is back (tracks drift less)
     swerve_range: float = 0.6  # m: a follower steers away from IR readings nearer than this (neighbours: 0.7 m)
     swerve_gain: float = 1.5  # push per reading at zero range, against a unit wish
     drive: DriveParams = field(default_factory=lambda: DriveParams(cruise=0.3, turn_rate=1.0, turn_gain=2.0,
@@ -71,28 +77,65 @@ class KeepFormationParams:
 
 @dataclass(frozen=True)
 class Line:
-    """The formation's shape: robots left to right, the leader, the spacing between neighbours."""
+    """The formation's shape: robots left to right, the leader, the spacing between neighbours; and the robots
+    known to have failed (``failed``). Every robot keeps its place; with robots failed, each re-links to the
+    nearest living robot on each side and the living robot nearest the leader's place acts as leader (ALLIANCE:
+    a teammate takes over a failed robot's task, spec §1; docs/decisions.md, "Keeping formation")."""
     names: tuple[str, ...]
     leader: str
     spacing: float
+    failed: frozenset = frozenset()
 
     def offset(self, name: str) -> float:
         """o_i: m to the leader's left of robot ``name``'s place."""
         return (self.names.index(self.leader) - self.names.index(name)) * self.spacing
 
-    def reference(self, name: str) -> str:
-        """Strategy I's assigned neighbour: the next robot towards the leader."""
-        i, lead = self.names.index(name), self.names.index(self.leader)
-        return self.names[i + 1] if i < lead else self.names[i - 1]
+    @property
+    def acting(self) -> str | None:
+        """Who leads: the leader, or once it has failed the living robot nearest its place in the line (ties: the
+        one nearer the line's middle, so the line's band stays the same, then the left); None if all failed."""
+        if self.leader not in self.failed:
+            return self.leader
+        living = [i for i, n in enumerate(self.names) if n not in self.failed]
+        if not living:
+            return None
+        lead, middle = self.names.index(self.leader), (len(self.names) - 1) / 2
+        return self.names[min(living, key=lambda i: (abs(i - lead), abs(i - middle), i))]
+
+    def reference(self, name: str) -> str | None:
+        """Strategy I's assigned neighbour: the next living robot towards the (acting) leader."""
+        acting = self.acting
+        if acting is None or acting == name:
+            return None
+        i, lead = self.names.index(name), self.names.index(acting)
+        step = 1 if i < lead else -1
+        return next(self.names[j] for j in range(i + step, lead + step, step) if self.names[j] not in self.failed)
 
     def neighbours(self, name: str) -> tuple[str, ...]:
+        """The nearest living robot on each side, left first."""
         i = self.names.index(name)
-        return tuple(self.names[j] for j in (i - 1, i + 1) if 0 <= j < len(self.names))
+        left = next((self.names[j] for j in range(i - 1, -1, -1) if self.names[j] not in self.failed), None)
+        right = next((self.names[j] for j in range(i + 1, len(self.names)) if self.names[j] not in self.failed),
+                     None)
+        return tuple(n for n in (left, right) if n is not None)
 
     def sensed(self, name: str, strategy: str) -> tuple[str, ...]:
         """Whom robot ``name`` senses: its neighbours, and from strategy II on the group leader."""
-        extra = (self.leader,) if strategy != "I" and name != self.leader else ()
+        acting = self.acting
+        extra = (acting,) if strategy != "I" and name != acting and acting is not None else ()
         return tuple(dict.fromkeys(self.neighbours(name) + extra))
+
+    def lead(self, poses: dict[str, np.ndarray]) -> np.ndarray | None:
+        """(x, y, heading) of the leader's place, from the acting leader's pose in ``poses`` (its own place is
+        offset from it across its heading); None while the acting leader's pose is unknown."""
+        acting = self.acting
+        if acting is None or acting not in poses:
+            return None
+        pose = poses[acting]
+        if acting == self.leader:
+            return pose
+        x, y = pose[:2] - self.offset(acting) * normal(pose[2])
+        return np.array([x, y, pose[2]])
 
 
 def cross(a, b) -> float:
@@ -123,6 +166,16 @@ class Lanes:
             return -math.inf
         turn = wrap_angle(self.headings[k] - self.headings[k - 1])
         return offset * math.tan(float(np.clip(turn, -math.radians(150), math.radians(150))) / 2)
+
+    def lane(self, offset: float) -> np.ndarray:
+        """The lane at ``offset`` as waypoints: the route's start, corners and end moved ``offset`` to the left,
+        each corner mitred (where the two legs' lanes meet)."""
+        points = [self.points[0] + offset * normal(self.headings[0])]
+        for k in range(1, len(self.points) - 1):
+            points.append(self.points[k] + self.corner_shift(k, offset) * self.directions[k]
+                          + offset * normal(self.headings[k]))
+        points.append(self.points[-1] + offset * normal(self.headings[-1]))
+        return np.array(points)
 
     def span(self, k: int, offset: float) -> tuple[float, float]:
         """(start, end) along leg k of the lane at ``offset``, measured from waypoint k."""
@@ -188,17 +241,17 @@ def place(strategy: str, line: Line, name: str, poses: dict[str, np.ndarray], ne
             return None
         x, y, heading = poses[ref]
         return Goal(np.array([x, y]) + (offset - line.offset(ref)) * normal(heading), float(heading), ref, False)
-    if line.leader not in poses:
+    lead = line.lead(poses)  # the leader's place, from whoever leads
+    if lead is None:
         return None
-    lead = poses[line.leader]
     if strategy == "IV" and lanes is not None:
         point, heading, moving = lanes.place(leg, offset, lead[:2])
-        return Goal(point, heading, line.leader if moving else None, True)
+        return Goal(point, heading, line.acting if moving else None, True)
     heading = float(lead[2])
     if strategy == "III" and news is not None:
         (x0, y0), (x1, y1) = news
         heading = math.atan2(y1 - y0, x1 - x0)
-    return Goal(lead[:2] + offset * normal(heading), heading, line.leader, strategy == "III")
+    return Goal(lead[:2] + offset * normal(heading), heading, line.acting, strategy == "III")
 
 
 def swerve(obs: Observation, params: KeepFormationParams) -> np.ndarray:
@@ -223,10 +276,12 @@ class Track:
         self.velocity = np.zeros(2)
         self.heading = 0.0
         self.time = 0.0
+        self.stood: tuple[np.ndarray, float] | None = None  # (where it stood, since when): within still_move of it
 
     def update(self, measured: np.ndarray, heading: float, time: float) -> None:
         if self.position is None:
             self.position, self.heading, self.time = measured.copy(), heading, time
+            self.stood = (self.position.copy(), time)
             return
         dt = max(time - self.time, 1e-3)
         predicted = self.position + self.velocity * dt
@@ -235,6 +290,13 @@ class Track:
         self.velocity = self.velocity + self.params.track_beta * residual / dt
         self.heading = wrap_angle(self.heading + self.params.heading_gain * wrap_angle(heading - self.heading))
         self.time = time
+        if np.linalg.norm(self.position - self.stood[0]) > self.params.still_move:  # filtered: noise stays within
+            self.stood = (self.position.copy(), time)
+
+    @property
+    def standing_for(self) -> float:
+        """s it has been sensed within ``still_move`` of one spot."""
+        return self.time - self.stood[1] if self.stood is not None else 0.0
 
     def pose(self, time: float) -> np.ndarray:
         x, y = self.position + self.velocity * (time - self.time)
@@ -247,8 +309,9 @@ class Track:
 
 class FormationRobot:
     """What every robot of the line shares: its own pose estimate, avoid-obstacles, the tracks of the teammates it
-    senses (from ``Observation.signals[SIGNAL]``, relative to itself), and steering that swerves round near
-    things."""
+    senses (from ``Observation.signals[SIGNAL]``, relative to itself), which teammates it judges failed
+    (:meth:`judge`), steering that swerves round near things, and follow-route (:meth:`follow_route`), which the
+    leader runs and a follower takes over when the leader has failed."""
 
     def __init__(self, robot: RobotModel, line: Line, strategy: str, params: KeepFormationParams,
                  rng: np.random.Generator, route: np.ndarray):
@@ -257,18 +320,68 @@ class FormationRobot:
         self.avoid = AvoidObstacles(robot.ir_sensors, robot.ir_bearings, (), rng, params.drive)
         self.tracks: dict[str, Track] = {}
         self.lanes = Lanes(route) if strategy == "IV" else None
+        self.course = self.lanes or Lanes(route)  # the route, as follow-route knows it (any robot may lead)
         self.leg = 0
         self.push = np.zeros(2)  # this tick's swerve, body frame
+        self.view = line  # the line as this robot knows it: with the teammates it judges failed
+        self.watched: dict[str, float] = {}  # teammate -> since when this robot has looked for it
+        self.failed_at: dict[str, np.ndarray | None] = {}  # failed teammate -> where it was last seen
+        # follow-route: the waypoints it drives to, the next one's index, when it reached the last
+        self.route: np.ndarray | None = None
+        self.target = 1
+        self.announce = True
+        self.finished_at: float | None = None
 
     def sense(self, obs: Observation, pose: np.ndarray) -> dict[str, np.ndarray]:
-        """Fold this tick's fresh readings into the tracks; the teammates' poses now."""
+        """Fold this tick's fresh readings into the tracks and judge who has failed; the poses now of the
+        teammates in sight (a track not refreshed for ``lost_after`` is out of sight, not extrapolated)."""
         for name, (dx, dy, dheading, when) in obs.signals.get(SIGNAL, {}).items():
             track = self.tracks.setdefault(name, Track(self.params))
             if when > track.time or track.position is None:
                 c, s = math.cos(pose[2]), math.sin(pose[2])
                 track.update(pose[:2] + np.array([c * dx - s * dy, s * dx + c * dy]),
                              wrap_angle(pose[2] + dheading), when)
-        return {name: t.pose(obs.time) for name, t in self.tracks.items() if t.position is not None}
+        self.judge(obs)
+        return {name: t.pose(obs.time) for name, t in self.tracks.items()
+                if t.position is not None and obs.time - t.time <= self.params.lost_after}
+
+    def judge(self, obs: Observation) -> None:
+        """Which teammates of the line have failed (spec §1.4, tau: "before assuming that that robot has ceased to
+        function"): one not heard on the radio within tau (``robots_present``) that is also out of sight for
+        ``lost_after`` s, or sensed standing for ``dead_after`` s. Standing is asked for too because a robot whose
+        radio alone failed still drives; and a robot that hears nobody at all doubts its own radio (§3.2: the
+        medium is not assumed), so it judges by sight alone. A failed robot heard, or seen moving, again is back."""
+        heard, failed = obs.robots_present, set(self.failed)
+        for name in self.line.names:
+            since = self.watched.get(name)
+            if name == self.name or since is None:
+                continue
+            track = self.tracks.get(name)
+            known = track is not None and track.position is not None
+            out_of_sight = obs.time - (track.time if known else since) > self.params.lost_after
+            if name in failed:  # back once heard, or seen well away from where it failed (its track, seen
+                was = self.failed_at.get(name)  # from a moving robot, drifts by its own pose error)
+                if name in heard or (known and not out_of_sight and was is not None
+                                     and np.linalg.norm(track.position - was) > self.params.back_move):
+                    failed.discard(name)
+            elif name not in heard and (out_of_sight or (heard and known
+                                                         and track.standing_for >= self.params.dead_after)):
+                failed.add(name)
+                self.failed_at[name] = track.position.copy() if known and not out_of_sight else None
+        if failed != self.failed:
+            self.view = replace(self.line, failed=frozenset(failed))
+        for name in self.sensing():
+            self.watched.setdefault(name, obs.time)
+
+    @property
+    def failed(self) -> frozenset:
+        return self.view.failed
+
+    def sensing(self) -> tuple[str, ...]:
+        """Whom this robot looks for (the mission's ``formation`` signal): whom the line says it senses, re-linked
+        past failed teammates, and the failed ones too (a robot standing dead is still there to be seen)."""
+        return tuple(dict.fromkeys(self.line.sensed(self.name, self.strategy)
+                                   + self.view.sensed(self.name, self.strategy) + tuple(sorted(self.failed))))
 
     def steer(self, speed: float, bearing: float, drive: DriveParams | None = None) -> tuple[float, float]:
         """(v, omega) for a bearing to steer by, bent away from what the IR sees near (:func:`swerve`): on the spot
@@ -284,47 +397,125 @@ class FormationRobot:
         return turn_to(pose, heading, self.params.drive, tolerance=0.0) or 0.0
 
     def follow_leg(self, poses: dict[str, np.ndarray]) -> None:
-        if self.lanes is not None and self.line.leader in poses:
-            lead = poses[self.line.leader]
-            self.leg = self.lanes.leg_of(self.leg, lead[:2], float(lead[2]), self.params.next_leg)
+        """The leader's leg of the route, from the leader's place as sensed (IV's lanes; follow-route's start
+        when this robot takes the lead)."""
+        lead = self.view.lead(poses)
+        if lead is not None:
+            self.leg = self.course.leg_of(self.leg, lead[:2], float(lead[2]), self.params.next_leg)
+
+    def hear_progress(self, obs: Observation) -> None:
+        """Follow-route's next waypoint, raised to the furthest one a teammate of the line announced: a robot that
+        takes the lead, or takes it back with a fresh controller, goes on from there, not from the route's start."""
+        for message in obs.inbox:
+            payload = message.payload
+            if message.sender in self.line.names and isinstance(payload, dict) and "waypoint" in payload:
+                near = np.linalg.norm(self.course.points - np.asarray(payload["waypoint"], float), axis=1)
+                if near.min() < 1e-6:
+                    self.target = max(self.target, int(np.argmin(near)))
+
+    def news(self) -> dict | None:
+        """What follow-route broadcasts: the route's waypoint it is making for (strategy III's news)."""
+        return {"waypoint": [float(v) for v in self.course.points[self.target]]} if self.announce else None
+
+    def pace(self, poses: dict[str, np.ndarray], pose: np.ndarray) -> float:
+        """Share of cruise speed: 1 while every sensed neighbour's shortfall (:meth:`Goal.shortfall`) is within
+        lag_slow, 0 at lag_stop."""
+        p = self.params
+        known = {**poses, self.name: pose}
+        news = (self.course.points[self.target - 1], self.course.points[self.target])
+        lag = 0.0
+        for name in self.view.neighbours(self.name):
+            goal = place(self.strategy, self.view, name, known, news, self.lanes, self.leg)
+            if goal is not None and name in poses:
+                lag = max(lag, goal.shortfall(poses[name][:2]))
+        return float(np.clip((p.lag_stop - lag) / max(p.lag_stop - p.lag_slow, 1e-6), 0.0, 1.0))
+
+    def follow_route(self, obs: Observation, pose: np.ndarray, poses: dict[str, np.ndarray]) -> Command:
+        """follow-route under avoid-obstacles: through ``route``'s waypoints from ``target``, announcing each,
+        at ``cruise`` scaled down while a neighbour is far from its place (:meth:`pace`); it holds at the last
+        waypoint, facing the last leg's way."""
+        broadcast = self.news()
+        evade = self.avoid(obs)
+        if evade is not None:
+            return Command(*evade, behaviour="avoid-obstacles", broadcast=broadcast)
+        self.push = swerve(obs, self.params)
+        self.follow_leg({**poses, self.name: pose})
+        share = self.pace(poses, pose)
+        last = self.target == len(self.route) - 1
+        drive = replace(self.params.drive, cruise=self.params.cruise * share,
+                        turn_rate=self.params.drive.turn_rate * max(share, 0.2),
+                        slow_radius=0.4 if last else self.params.drive.slow_radius)
+        command = steer_to(pose, self.route[self.target], drive, self.params.arrive)
+        while command is None and not last:
+            self.target += 1
+            last = self.target == len(self.route) - 1
+            broadcast = self.news()
+            command = steer_to(pose, self.route[self.target], drive, self.params.arrive)
+        if command is None:  # at the last waypoint: face the last leg's way, where the line is laid across
+            if self.finished_at is None:
+                self.finished_at = obs.time
+            way = self.route[-1] - self.route[-2]
+            turn = turn_to(pose, math.atan2(way[1], way[0]), self.params.drive, tolerance=0.02)
+            return Command(0.0, turn or 0.0, behaviour="hold", broadcast=broadcast)
+        if np.any(self.push):  # something near: the same way bent round it (steer_to's law otherwise)
+            way = self.route[self.target] - pose[:2]
+            speed = drive.cruise * min(1.0, float(np.linalg.norm(way)) / drive.slow_radius)
+            command = self.steer(speed, wrap_angle(math.atan2(way[1], way[0]) - pose[2]), drive)
+        return Command(*command, behaviour="follow-route", broadcast=broadcast)
 
 
 class KeepFormation(FormationRobot):
     """A follower: KEEP_FORMATION by its strategy, under avoid-obstacles. Strategy III listens for the leader's
-    announced waypoint (``{"waypoint": [x, y]}`` riding on its broadcasts)."""
+    announced waypoint (``{"waypoint": [x, y]}`` riding on its broadcasts). Once the leader has failed and this
+    robot is the living one nearest the leader's place (:attr:`Line.acting`), it takes over follow-route
+    (ALLIANCE, spec §1: a capable teammate takes over a failed robot's task) along its own lane: the route offset
+    by its place, corners mitred, so that every place, the leader's empty one too, stays where it was."""
 
     def __init__(self, robot: RobotModel, line: Line, strategy: str, params: KeepFormationParams,
                  rng: np.random.Generator, route: np.ndarray):
         super().__init__(robot, line, strategy, params, rng, route)
-        self.news: tuple | None = None  # (where the leader was, the waypoint it announced there)
+        self.news_heard: tuple | None = None  # (where the leader was, the waypoint it announced there)
 
     def __call__(self, obs: Observation) -> Command:
         pose = self.estimate.update(obs)
         if pose is None:
             return Command(behaviour="keep-formation")
         poses = self.sense(obs, pose)
+        self.hear_progress(obs)
+        if self.view.acting == self.name:
+            return self.take_lead(obs, pose, poses)
         self.listen(obs, poses)
         evade = self.avoid(obs)
         if evade is not None:
             return Command(*evade, behaviour="avoid-obstacles")
         self.push = swerve(obs, self.params)
         self.follow_leg(poses)
-        goal = place(self.strategy, self.line, self.name, poses, self.news, self.lanes, self.leg)
+        goal = place(self.strategy, self.view, self.name, poses, self.news_heard, self.lanes, self.leg)
         if goal is None:
             return Command(behaviour="keep-formation")
         pace = self.tracks[goal.pace_of].speed if goal.pace_of is not None else 0.0
         drive = self.keep_lane if goal.lane else self.make_for
         return Command(*drive(pose, goal, pace), behaviour="keep-formation")
 
+    def take_lead(self, obs: Observation, pose: np.ndarray, poses: dict[str, np.ndarray]) -> Command:
+        """follow-route along this robot's lane, from the waypoint the leader last announced or, if further, the
+        one after the leg it was last sensed on."""
+        if self.route is None:
+            self.route = self.course.lane(self.line.offset(self.name))
+            self.target = min(max(self.target, self.leg + 1), len(self.route) - 1)
+        return self.follow_route(obs, pose, poses)
+
     def listen(self, obs: Observation, poses: dict[str, np.ndarray]) -> None:
         """Strategy III's news: a waypoint the leader announces, with where the leader is as it is heard."""
+        acting = self.view.acting
+        lead = self.view.lead(poses)
         for message in obs.inbox:
             payload = message.payload
-            if message.sender == self.line.leader and isinstance(payload, dict) and "waypoint" in payload \
-                    and self.line.leader in poses:
+            if message.sender == acting and isinstance(payload, dict) and "waypoint" in payload \
+                    and lead is not None:
                 waypoint = tuple(float(v) for v in payload["waypoint"])
-                if self.news is None or self.news[1] != waypoint:
-                    self.news = (tuple(poses[self.line.leader][:2]), waypoint)
+                if self.news_heard is None or self.news_heard[1] != waypoint:
+                    self.news_heard = (tuple(lead[:2]), waypoint)
 
     def make_for(self, pose: np.ndarray, goal: Goal, pace: float) -> tuple[float, float]:
         """I and II: towards the place at ``pace`` (the speed it moves at) along the line's heading plus a pull to
@@ -362,65 +553,22 @@ class KeepFormation(FormationRobot):
         return self.steer(speed, wrap_angle(math.atan2(aim[1] - pose[1], aim[0] - pose[0]) - pose[2]))
 
 class RouteLeader(FormationRobot):
-    """The group leader: follow-route through the waypoints, announcing each new one (strategy III's news), at
-    ``cruise`` scaled down while a neighbour is far from its place; it holds at the last waypoint, facing the last
-    leg's way. With no line (``line`` of itself alone) it is a plain route follower (:class:`Crossing` drives
-    one)."""
+    """The group leader: follow-route through the waypoints (:meth:`FormationRobot.follow_route`), announcing each
+    new one (strategy III's news), waiting for its neighbours (re-linked past failed ones). With no line (``line``
+    of itself alone) it is a plain route follower (:class:`Crossing` drives one)."""
 
     def __init__(self, robot: RobotModel, line: Line, strategy: str, params: KeepFormationParams,
                  rng: np.random.Generator, route: np.ndarray, announce: bool = True):
         super().__init__(robot, line, strategy, params, rng, route)
         self.route = np.asarray(route, float)
-        self.target = 1
         self.announce = announce
-        self.finished_at: float | None = None
-
-    def pace(self, poses: dict[str, np.ndarray], pose: np.ndarray) -> float:
-        """Share of cruise speed: 1 while every sensed neighbour's shortfall (:meth:`Goal.shortfall`) is within
-        lag_slow, 0 at lag_stop."""
-        p = self.params
-        known = {**poses, self.name: pose}
-        news = (self.route[self.target - 1], self.route[self.target])
-        lag = 0.0
-        for name in self.line.neighbours(self.name):
-            goal = place(self.strategy, self.line, name, known, news, self.lanes, self.leg)
-            if goal is not None and name in poses:
-                lag = max(lag, goal.shortfall(poses[name][:2]))
-        return float(np.clip((p.lag_stop - lag) / max(p.lag_stop - p.lag_slow, 1e-6), 0.0, 1.0))
 
     def __call__(self, obs: Observation) -> Command:
+        self.hear_progress(obs)  # a teammate led while it was down (a fresh controller after a revive)
         pose = self.estimate.update(obs)
-        broadcast = {"waypoint": [float(v) for v in self.route[self.target]]} if self.announce else None
         if pose is None:
-            return Command(behaviour="follow-route", broadcast=broadcast)
-        poses = self.sense(obs, pose)
-        evade = self.avoid(obs)
-        if evade is not None:
-            return Command(*evade, behaviour="avoid-obstacles", broadcast=broadcast)
-        self.push = swerve(obs, self.params)
-        self.follow_leg({**poses, self.name: pose})
-        share = self.pace(poses, pose)
-        last = self.target == len(self.route) - 1
-        drive = replace(self.params.drive, cruise=self.params.cruise * share,
-                        turn_rate=self.params.drive.turn_rate * max(share, 0.2),
-                        slow_radius=0.4 if last else self.params.drive.slow_radius)
-        command = steer_to(pose, self.route[self.target], drive, self.params.arrive)
-        while command is None and not last:
-            self.target += 1
-            last = self.target == len(self.route) - 1
-            broadcast = {"waypoint": [float(v) for v in self.route[self.target]]} if self.announce else None
-            command = steer_to(pose, self.route[self.target], drive, self.params.arrive)
-        if command is None:  # at the last waypoint: face the last leg's way, where the line is laid across
-            if self.finished_at is None:
-                self.finished_at = obs.time
-            way = self.route[-1] - self.route[-2]
-            turn = turn_to(pose, math.atan2(way[1], way[0]), self.params.drive, tolerance=0.02)
-            return Command(0.0, turn or 0.0, behaviour="hold", broadcast=broadcast)
-        if np.any(self.push):  # something near: the same way bent round it (steer_to's law otherwise)
-            way = self.route[self.target] - pose[:2]
-            speed = drive.cruise * min(1.0, float(np.linalg.norm(way)) / drive.slow_radius)
-            command = self.steer(speed, wrap_angle(math.atan2(way[1], way[0]) - pose[2]), drive)
-        return Command(*command, behaviour="follow-route", broadcast=broadcast)
+            return Command(behaviour="follow-route", broadcast=self.news())
+        return self.follow_route(obs, pose, self.sense(obs, pose))
 
 
 class Crossing:

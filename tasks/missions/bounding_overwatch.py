@@ -9,9 +9,9 @@ default route zig-zags east between two lanes (A's waypoints on the north lane, 
 leapfrog past each other. The mission completes when the leader of the last bound has reached the route's final
 waypoint and announced the bound complete.
 
-Faults: ``kill:ROBOT@T`` (or ``remove``) a leader: its group hears nothing from it for tau, a new leader emerges
-and the bounding goes on. Leaders are decided at run time, but a seed decides them: run once, read ``leaders``
-in summary.json (or the ``emerge-leader`` behaviour events), then kill that robot in a second run. Measures: each
+Faults: ``kill:@leader@T`` (or ``remove``) kills whoever leads the group whose turn it is to bound at T
+(``@leader:A``, ``@leader:B``: that group's leader; :meth:`BoundingOverwatchMission.role_holder`): its group hears
+nothing from it for tau, a new leader emerges and the bounding goes on. ``kill:ROBOT@T`` names a robot. Measures: each
 robot's group and kind, join decisions, leaders over time, bounds (group, leader, start, end), completion time
 and final positions (docs/bounding-overwatch.md).
 """
@@ -96,6 +96,9 @@ class BoundingOverwatchMission(ScenarioMission):
     Controller = OverwatchSettings
     default_duration = 900.0  # s: the default route takes 200-300 s (docs/bounding-overwatch.md)
     video_speedup = 4.0
+    # Roles a fault may strike (``kill:@leader@300``), resolved by role_holder when the fault is due
+    fault_roles = {"leader": "the leader of the group whose turn it is to bound (leading it, or about to)",
+                   "leader:A": "group A's leader", "leader:B": "group B's leader"}
 
     @staticmethod
     def radio_of(params: BoundingOverwatchParams, radio: RadioConfig) -> RadioConfig:
@@ -171,6 +174,23 @@ class BoundingOverwatchMission(ScenarioMission):
         scene.info["brains"][robot.name] = brain
         return brain
 
+    def role_holder(self, world, role: str) -> str | None:
+        """The live robot that holds ``role`` (one of :attr:`fault_roles`) now, or None (no leader elected yet, or
+        the last one dead and no successor yet, or the route done). A group's leader is the robot that takes itself
+        for one; two that claimed within one radio period both do until they hear each other (§6.3 gives no rule):
+        the earlier claim, then the higher priority, is the one its group keeps, as :meth:`Knowledge.leader` says."""
+        brains = world.scene.info["brains"]
+        if role == "leader":
+            done = len({r.bound for r in self.bounds(world) if r.end is not None})
+            if done >= len(world.scene.scenario.task.route):
+                return None
+            group = GROUPS[done % 2]
+        else:
+            group = role.partition(":")[2]
+        claims = [(b.k.me.leader_since, b.k.me.priority, name) for name, b in brains.items()
+                  if world.robots[name].active and b.group == group and b.is_leader]
+        return min(claims)[2] if claims else None
+
     # -- the video's map ----------------------------------------------------------------------------------------------
     def video_panel(self, world) -> np.ndarray | None:
         """A top-down map beside the 3-D view: the route (each waypoint in its group's colour), every robot as a dot
@@ -234,10 +254,10 @@ class BoundingOverwatchMission(ScenarioMission):
     def outcome(self, world) -> tuple[bool, dict]:
         scenario, brains = world.scene.scenario, world.scene.info["brains"]
         complete = self.done(world)
-        gone = {}  # robot -> when a kill or remove took it
-        for fault in world.config.faults:
-            if fault.kind in ("kill", "remove") and fault.time <= world.time:
-                gone.setdefault(fault.robot, fault.time)
+        gone = {}  # robot -> when a kill or remove took it (a fault by role: the robot it struck)
+        for fault, struck in zip(world.schedule, world.struck):
+            if fault.kind in ("kill", "remove") and struck is not None:
+                gone.setdefault(struck[0], struck[1])
         groups = {n: [b.group, b.k.me.kind] for n, b in brains.items()}
         kinds = {g: {k: sum(1 for grp, kind in groups.values() if grp == g and kind == k) for k in KINDS}
                  for g in GROUPS}

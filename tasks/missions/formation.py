@@ -15,6 +15,8 @@ is within ``task.settle`` of its place. §7.2 does not say which way the line is
 "route reading" (``fe_route``, ``normalised_error_route``) lays it across the leader's current leg of the route
 instead of its heading (docs/decisions.md, "Keeping formation"). Also measured: seconds a follower spent turned
 round (heading more than 120 degrees off the leader's) and seconds the line's left-to-right order was broken.
+With robots killed or removed, all of it is over the living robots, with the living robot nearest the leader's
+place acting as leader (:meth:`FormationMission.living`; docs/decisions.md, "Keeping formation": a failed robot).
 """
 from __future__ import annotations
 
@@ -286,6 +288,7 @@ class FormationMission(ScenarioMission):
         if name not in line.names:
             return {}
         cfg = world.positioning.config
+        half = np.array(world.scene.scenario.arena.size) / 2
         last = info["sensed"].get(name)
         if last is not None and world.time < last[0] + cfg.period - 1e-9:
             return {SIGNAL: last[1]}
@@ -294,9 +297,13 @@ class FormationMission(ScenarioMission):
         x, y, yaw = world.pose(me)
         c, s = math.cos(yaw), math.sin(yaw)
         readings = {}
-        for other in line.sensed(name, world.scene.scenario.task.strategy):
+        brain = info["brains"].get(name)  # whom it looks for: its neighbours, re-linked past failed ones
+        whom = brain.sensing() if brain is not None else line.sensed(name, world.scene.scenario.task.strategy)
+        for other in whom:
             robot = world.robots[other]
             ox, oy, oyaw = world.pose(robot)
+            if abs(ox) > half[0] or abs(oy) > half[1]:  # taken out of the arena (remove): out of sight
+                continue
             moving = max(world.speed(me), world.speed(robot)) > cfg.moving_speed
             noise = rng.normal(0.0, cfg.noise_moving if moving else cfg.noise_still, 2)
             dx, dy = ox - x, oy - y
@@ -306,42 +313,67 @@ class FormationMission(ScenarioMission):
         return {SIGNAL: readings}
 
     # -- the metric, at integer seconds --------------------------------------------------------------------------------
-    def places(self, world, across: float | None = None) -> dict[str, tuple[np.ndarray, np.ndarray]]:
-        """(true position, proper place) of every robot of the line: the place given the leader's current pose,
-        across its heading or, given ``across``, across that heading (the route reading: the leader's leg)."""
+    @staticmethod
+    def living(world) -> Line:
+        """The line as it is: its failed (killed or removed) robots marked, so the living robot nearest the
+        leader's place acts as leader (:attr:`Line.acting`)."""
         line: Line = world.scene.info["line"]
-        lead = world.pose(world.robots[line.leader])
+        failed = frozenset(n for n in line.names if not world.robots[n].active)
+        return dataclasses.replace(line, failed=failed) if failed else line
+
+    def places(self, world, across: float | None = None) -> dict[str, tuple[np.ndarray, np.ndarray]]:
+        """(true position, proper place) of every living robot of the line: the place given the (acting) leader's
+        current pose, across its heading or, given ``across``, across that heading (the route reading: the
+        leader's leg). A failed robot has no place to be in; an acting leader's own place is offset from the
+        leader's, which the others' are taken from."""
+        line = self.living(world)
+        if line.acting is None:
+            return {}
+        lead = world.pose(world.robots[line.acting])
         side = normal(lead[2] if across is None else across)
-        return {n: (world.pose(world.robots[n])[:2], lead[:2] + line.offset(n) * side) for n in line.names}
+        origin = lead[:2] if line.acting == line.leader else lead[:2] - line.offset(line.acting) * side
+        return {n: (world.pose(world.robots[n])[:2], origin + line.offset(n) * side)
+                for n in line.names if n not in line.failed}
 
     def _measure(self, world) -> None:
         info = world.scene.info
         if world.time + 1e-6 < len(info["errors"]):
             return
-        line: Line = info["line"]
-        lead = world.pose(world.robots[line.leader])
+        line = self.living(world)  # failed robots have no place: the metric is over the living (the acting leader's
+        acting = line.acting      # place is the leader's offset; it is no follower)
+        for name, robot in world.robots.items():
+            info["tracks"][name].append([round(float(v), 3) for v in world.pose(robot)])
+        if acting is None:
+            info["errors"].append(0.0)
+            info["distances"].append({})
+            info["route_errors"].append(0.0)
+            return
+        lead = line.lead({acting: world.pose(world.robots[acting])})
         info["leg"] = info["lanes"].leg_of(info["leg"], lead[:2], float(lead[2]), 1.0)
         places = self.places(world)
-        distances = {n: float(np.linalg.norm(p - q)) for n, (p, q) in places.items() if n != line.leader}
+        distances = {n: float(np.linalg.norm(p - q)) for n, (p, q) in places.items() if n != acting}
         info["errors"].append(sum(distances.values()))
         info["distances"].append(distances)
         info["route_errors"].append(sum(float(np.linalg.norm(p - q)) for n, (p, q) in self.places(
-            world, info["lanes"].headings[info["leg"]]).items() if n != line.leader))
-        for name, robot in world.robots.items():
-            info["tracks"][name].append([round(float(v), 3) for v in world.pose(robot)])
-        headings = [world.pose(world.robots[n])[2] for n in line.names if n != line.leader]
+            world, info["lanes"].headings[info["leg"]]).items() if n != acting))
+        headings = [world.pose(world.robots[n])[2] for n in places if n != acting]
         info["turned_round_s"] += any(abs(wrap_angle(h - lead[2])) > TURNED_ROUND for h in headings)
-        lateral = [float(np.dot(places[n][0] - lead[:2], normal(lead[2]))) for n in line.names]
+        lateral = [float(np.dot(places[n][0] - lead[:2], normal(lead[2]))) for n in places]
         info["order_broken_s"] += any(a <= b for a, b in zip(lateral, lateral[1:]))
 
     def complete(self, world) -> bool:
+        """The (acting) leader has finished its route and stands at its place at the route's end, and every
+        living robot of the line is at its place: with robots failed, the living ones stand in their order
+        with the failed ones' places empty (docs/decisions.md, "Keeping formation")."""
         info, task = world.scene.info, world.scene.scenario.task
-        leader = info["brains"].get(task.leader)
-        if leader is None or leader.finished_at is None or not world.robots[task.leader].active:
+        line = self.living(world)
+        leader = info["brains"].get(line.acting) if line.acting is not None else None
+        if leader is None or leader.finished_at is None:
             return False
         places = self.places(world)
-        end = np.array([task.route[-1].x, task.route[-1].y])
-        return (np.linalg.norm(places[task.leader][0] - end) <= task.settle
+        route = info["route"]
+        end = route[-1] + line.offset(line.acting) * normal(math.atan2(*(route[-1] - route[-2])[::-1]))
+        return (np.linalg.norm(places[line.acting][0] - end) <= task.settle
                 and all(np.linalg.norm(p - q) <= task.settle for p, q in places.values()))
 
     def done(self, world) -> bool:
@@ -353,8 +385,8 @@ class FormationMission(ScenarioMission):
         completed = self.complete(world)
         t_max = max(world.time, 1e-9)
         errors = info["errors"]
-        per_robot = {n: round(float(np.mean([d[n] for d in info["distances"]])), 3)
-                     for n in (info["distances"][0] if info["distances"] else {})}
+        per_robot = {n: round(float(np.mean([d[n] for d in info["distances"] if n in d])), 3)
+                     for n in dict.fromkeys(n for d in info["distances"] for n in d)}  # (while it lived, led not)
         metrics = {
             "strategy": world.scene.scenario.task.strategy,
             "mission_time_s": round(world.time, 3),

@@ -32,7 +32,10 @@ def colours(names) -> dict[str, tuple[float, float, float]]:
 def panel_image(scenario, info: dict, places: dict, time: float) -> np.ndarray:
     """BGR image: the PANEL_SPAN m around the leader from above, north up: the route, obstacles, each robot
     (filled) and its proper place given the leader's pose (ring of the same colour), and fe_t."""
+    half = np.array(scenario.arena.size) / 2
     centre = np.array(info["tracks"][info["line"].leader][-1][:2])
+    if np.any(np.abs(centre) > half) and places:  # the leader taken out of the arena: centre on the line
+        centre = np.mean([p for p, _ in places.values()], axis=0)
     scale = PANEL / PANEL_SPAN
     image = np.full((PANEL, PANEL, 3), 255, np.uint8)
 
@@ -40,7 +43,6 @@ def panel_image(scenario, info: dict, places: dict, time: float) -> np.ndarray:
         x, y = (np.asarray(point, float) - centre) * scale
         return int(PANEL / 2 + x), int(PANEL / 2 - y)
 
-    half = np.array(scenario.arena.size) / 2
     cv2.rectangle(image, px(-half), px(half), BLACK, 2)
     for box in scenario.arena.boxes:
         cv2.fillPoly(image, [np.array([px(p) for p in _box_corners(box)], np.int32)], GREY)
@@ -73,6 +75,7 @@ def write_formation(path: Path, scenario, info: dict) -> None:
     for (name, track), colour in zip(info["tracks"].items(), colours(info["tracks"]).values()):
         if track:
             xy = np.array(track)[:, :2]
+            xy[np.any(np.abs(xy) > np.array(scenario.arena.size) / 2, axis=1)] = np.nan  # removed: off the map
             top.plot(xy[:, 0], xy[:, 1], color=colour, lw=1.2, label=name)
     half = np.array(scenario.arena.size) / 2
     top.set(xlim=(-half[0], half[0]), ylim=(-half[1], half[1]), aspect="equal", xlabel="x (m)", ylabel="y (m)",

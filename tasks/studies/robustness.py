@@ -5,7 +5,9 @@ can suffer (:func:`supported`; the pairs left out and why are in :data:`NOT_SUPP
 with its own defaults (duration included) on each trial seed, with the fault injected at a random time (in 5-60 %
 of the mission's typical time, :data:`TYPICAL_S`, or of ``duration`` if that is shorter) on a random robot. The draws
 come from a generator seeded by the study seed, the mission, the fault and the trial seed (:func:`faults_of`), so a
-study is reproducible and adding a seed changes no other run. Kinds that only make sense
+study is reproducible and adding a seed changes no other run. A mission whose headline fault strikes a role rather
+than a robot gets it in that kind's cell (:data:`ROLE_TARGETS`: bounding overwatch's kill is ``kill:@leader@T``,
+issue 29's "overwatch with a leader killed"; the role is resolved when the fault is due). Kinds that only make sense
 after another fault are run after it: ``radio-on`` after a ``radio-off`` of the same robot, ``revive`` after a
 ``kill`` or a ``remove`` (drawn).
 
@@ -41,6 +43,8 @@ MISSIONS = ("wander", "navigate", "hazardous-waste", "box-pushing", "explore", "
 TYPICAL_S = {"wander": 60.0, "navigate": 60.0, "hazardous-waste": 400.0, "box-pushing": 450.0, "explore": 1800.0,
              "janitorial": 1200.0, "bounding-overwatch": 250.0, "formation": 300.0}
 SETTINGS = {"explore": ("backend=kinematic",)}  # --set per mission (module docstring)
+# (mission, kind) -> the role that kind strikes instead of a drawn robot (teamsim.faults: resolved at run time)
+ROLE_TARGETS = {("bounding-overwatch", "kill"): "@leader"}
 NEWCOMER = {"wander": "diffdrive", "hazardous-waste": "r2", "box-pushing": "genghis2", "janitorial": "janitor"}
 _NO_GRIPPER = "its robots have no gripper"
 _NO_RADIO = "its robots send no messages, so the radio faults change nothing"
@@ -117,6 +121,7 @@ def faults_of(study: RobustnessStudy, mission: str, fault: str, seed: int) -> li
     team = team_of(mission, seed)
     candidates = [(n, k) for n, k in team if fault != "break-gripper" or _parts(k)[1]]
     name, kind = candidates[int(rng.integers(len(candidates)))]
+    name = ROLE_TARGETS.get((mission, fault), name)  # (drawn all the same: the time's draw stays as it was)
     typical = min(TYPICAL_S[mission], study.duration or math.inf)  # a short study draws within its duration
     at = round(float(rng.uniform(0.05, 0.6) * typical), 1)
     later = round(at + float(rng.uniform(0.1, 0.3) * typical), 1)
@@ -339,14 +344,19 @@ def report(study: RobustnessStudy, rows: list[dict]) -> str:
     return "\n".join(lines) + "\n"
 
 
+MAX_SEED, MAX_SEEDS = 2**62, 10**6  # as a study's --seed; a million runs is days of work
+
+
 def seeds_from(text: str) -> tuple[int, ...]:
     """``--seeds``: N (seeds 0..N-1) or A-B (seeds A..B, both included)."""
     first, dash, last = text.strip().partition("-")
     try:
-        seeds = tuple(range(int(first), int(last) + 1)) if dash else tuple(range(int(first)))
+        seeds = range(int(first), int(last) + 1) if dash else range(int(first))
     except ValueError:
         raise ConfigError(f"--seeds {text!r}: a number of seeds N or a range A-B") from None
     if not seeds:
         raise ConfigError(f"--seeds {text!r}: no seeds (N >= 1, A <= B)")
-    return seeds
+    if seeds[0] < 0 or seeds[-1] >= MAX_SEED or len(seeds) > MAX_SEEDS:
+        raise ConfigError(f"--seeds {text!r}: at most {MAX_SEEDS} seeds, each in [0, 2**62)")
+    return tuple(seeds)
 

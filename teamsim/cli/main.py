@@ -93,7 +93,7 @@ def _build_parser() -> argparse.ArgumentParser:
                                                                       "RFRC", "FRC-printed")))
     navigation.add_argument("--trials", type=_positive_int("--trials"))
     navigation.add_argument("--workers", type=_positive_int("--workers"))
-    navigation.add_argument("--seed", type=int)
+    navigation.add_argument("--seed", type=_study_seed)
     navigation.add_argument("--out", type=Path, help="output folder (default: renders/study-navigation)")
     _resume_option(navigation, "renders/study-navigation")
     navigation.add_argument("--backend", choices=("kinematic", "physics"),
@@ -115,7 +115,7 @@ def _build_parser() -> argparse.ArgumentParser:
     awareness = studies.add_parser("awareness", help="Parker ch.5: hazardous waste with and without awareness, "
                                                      "2 and 3 robots (versions I-IV)")
     awareness.add_argument("--missions", type=_positive_int("--missions"), default=10, help="missions per version")
-    awareness.add_argument("--duration", type=float, help="simulated seconds per mission (mission default if unset)")
+    _duration_option(awareness, "simulated seconds per mission (mission default if unset)")
     _run_options(awareness, workers=2, out="renders/study-awareness")
 
     rho = studies.add_parser("janitorial-rho", help="Parker §6.2.3: the janitorial service's mission time at "
@@ -124,7 +124,7 @@ def _build_parser() -> argparse.ArgumentParser:
     rho.add_argument("--rhos", type=_csv_of("rho", None, float), default=JANITORIAL_RHOS,
                      help="comma-separated broadcasts per second per robot, 0 = no messages (default: "
                           f"{','.join(f'{r:g}' for r in JANITORIAL_RHOS)})")
-    rho.add_argument("--duration", type=float, help="simulated seconds per mission (mission default if unset)")
+    _duration_option(rho, "simulated seconds per mission (mission default if unset)")
     _run_options(rho, workers=2, out="renders/study-janitorial-rho")
 
     faults = studies.add_parser("cleanup-faults", help="Parker §3.8.4: the 3-robot cleanup with red killed during "
@@ -147,7 +147,7 @@ def _build_parser() -> argparse.ArgumentParser:
                            help="runs per strategy (the thesis: 10)")
     formation.add_argument("--strategies", type=_csv_of("strategy", FORMATION_STRATEGIES),
                            default=FORMATION_STRATEGIES, help=f"comma-separated: {','.join(FORMATION_STRATEGIES)}")
-    formation.add_argument("--duration", type=float, help="simulated seconds per run (mission default if unset)")
+    _duration_option(formation, "simulated seconds per run (mission default if unset)")
     _run_options(formation, workers=2, out="renders/study-formation")
 
     robust = studies.add_parser("robustness", help="every mission under every fault kind it supports, over seeds "
@@ -158,7 +158,7 @@ def _build_parser() -> argparse.ArgumentParser:
                         help=f"comma-separated (default: all): {','.join(ROBUSTNESS_MISSIONS)}")
     robust.add_argument("--faults", type=_csv_of("fault", FAULT_KINDS), default=FAULT_KINDS,
                         help=f"comma-separated fault kinds (default: all): {','.join(FAULT_KINDS)}")
-    robust.add_argument("--duration", type=float, help="simulated seconds per run (default: each mission's own)")
+    _duration_option(robust, "simulated seconds per run (default: each mission's own)")
     _run_options(robust, workers=2, out="renders/study-robustness")
 
     bench = commands.add_parser("bench", help="benchmarks")
@@ -179,7 +179,8 @@ def _trial_arguments(parser: argparse.ArgumentParser) -> None:
                         help="mission parameter (robots=5), group.key (radio.loss=0.2) or any scenario field by "
                              "its dotted path (robots.red.pose=[1,2,0])")
     parser.add_argument("--fault", action="append", default=[], metavar="SPEC",
-                        help=f"{SPEC_FORM}; kinds: {', '.join(FAULT_KINDS)}")
+                        help=f"{SPEC_FORM}; kinds: {', '.join(FAULT_KINDS)}; ROBOT may be @ROLE where the "
+                             "mission elects roles (bounding-overwatch: @leader, @leader:A, @leader:B)")
 
 
 def _sweep_options(parser: argparse.ArgumentParser, full_help: str, workers: int, out: str) -> None:
@@ -191,9 +192,13 @@ def _sweep_options(parser: argparse.ArgumentParser, full_help: str, workers: int
 def _run_options(parser: argparse.ArgumentParser, workers: int, out: str) -> None:
     """--workers, --seed and --out of a study."""
     parser.add_argument("--workers", type=_positive_int("--workers"), default=workers)
-    parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--seed", type=_study_seed, default=0)
     parser.add_argument("--out", type=Path, help=f"output folder (default: {out})")
     _resume_option(parser, out)
+
+
+def _duration_option(parser: argparse.ArgumentParser, meaning: str) -> None:
+    parser.add_argument("--duration", type=_seconds("--duration"), help=meaning)
 
 
 def _resume_option(parser: argparse.ArgumentParser, out: str) -> None:
@@ -238,9 +243,19 @@ def _seconds(flag: str):
     return parse
 
 
+STUDY_SEEDS = 2**62  # a study's trials take seeds from its --seed upwards: headroom below the trial limit 2**63
+
+
+def _study_seed(text: str) -> int:
+    """An argparse type: a study's --seed, a whole number in [0, 2**62)."""
+    if not (text.isascii() and text.isdigit()) or int(text) >= STUDY_SEEDS:
+        raise argparse.ArgumentTypeError("--seed must be a whole number in [0, 2**62)")
+    return int(text)
+
+
 def _positive_int(flag: str):
     def parse(text: str) -> int:
-        if not text.isdigit() or int(text) < 1:
+        if not (text.isascii() and text.isdigit()) or int(text) < 1:
             raise argparse.ArgumentTypeError(f"{flag} must be a whole number >= 1")
         return int(text)
     return parse
@@ -267,16 +282,12 @@ def cmd_study(args) -> int:
     elif args.study == "awareness":
         from teamsim.tasks.studies.awareness import AwarenessStudy, run_study
 
-        if args.duration is not None and not args.duration > 0:
-            raise ConfigError("--duration: must be > 0 simulated seconds")
         out = run_study(AwarenessStudy(missions=args.missions, seed=args.seed, workers=args.workers, out=args.out,
                                        duration=args.duration, resume=args.resume))
         print(f"wrote {out / 'report.md'} and {out / 'results.csv'}")
     elif args.study == "janitorial-rho":
         if not all(0.0 <= rho <= 100.0 for rho in args.rhos):  # (NaN fails too)
             raise ConfigError("--rhos: each must be a number of broadcasts per second in [0, 100]")
-        if args.duration is not None and not args.duration > 0:
-            raise ConfigError("--duration: must be > 0 simulated seconds")
         from teamsim.tasks.studies.janitorial_rho import JanitorialRhoStudy, run_study
 
         out = run_study(JanitorialRhoStudy(rhos=args.rhos, missions=args.missions, seed=args.seed,
@@ -296,8 +307,6 @@ def cmd_study(args) -> int:
                                         workers=args.workers, out=args.out, resume=args.resume))
         print(f"wrote {out / 'report.md'} and {out / 'results.csv'}")
     elif args.study == "formation":
-        if args.duration is not None and not args.duration > 0:
-            raise ConfigError("--duration: must be > 0 simulated seconds")
         from teamsim.tasks.studies.formation import FormationStudy, run_study
 
         out = run_study(FormationStudy(runs=args.runs, seed=args.seed, strategies=args.strategies,
@@ -316,8 +325,6 @@ def cmd_study(args) -> int:
 
         from teamsim.tasks.studies.robustness import RobustnessStudy, run_study, seeds_from
 
-        if args.duration is not None and not args.duration > 0:
-            raise ConfigError("--duration: must be > 0 simulated seconds")
         began = time.perf_counter()
         out = run_study(RobustnessStudy(seeds=seeds_from(args.seeds), seed=args.seed, missions=args.missions,
                                         faults=args.faults, duration=args.duration, workers=args.workers,

@@ -218,3 +218,29 @@ def test_health_instances_do_not_share_motor_sets():
     a, b = Health(), Health()
     apply_fault(parse_fault("break-motor:red@1"), a, MOTORS)
     assert b.broken_motors == set()
+
+
+# ---------------------------------------------------------------- faults by run-time role (kill:@leader@300)
+
+
+@pytest.mark.parametrize("spec, robot, role", [
+    ("kill:@leader@300", "@leader", "leader"),
+    ("kill:@leader:A@12.5", "@leader:A", "leader:A"),
+    ("break-motor:@leader@5,motor=left", "@leader", "leader"),
+    ("kill:red@60", "red", None),
+])
+def test_a_role_target_is_marked_by_at(spec, robot, role):
+    fault = parse_fault(spec)
+    assert (fault.robot, fault.role) == (robot, role)
+    assert fault.describe()["robot"] == robot  # the schedule keeps the role; the world records whom it struck
+
+
+@pytest.mark.parametrize("spec", ["kill:red:A@3", "kill:@@leader@3", "kill:@leader:@3", "kill:@leader:A:B@3"])
+def test_a_role_is_written_at_role_or_at_role_colon_qualifier(spec):
+    assert SPEC_FORM in parse_error(spec)
+
+
+@pytest.mark.parametrize("kind", ["add-robot", "revive"])
+def test_a_role_cannot_bring_a_robot_in_or_back(kind):
+    message = parse_error(f"{kind}:@leader@3")
+    assert f"{kind} needs a robot's name, not a role" in message and "kill" in message

@@ -21,9 +21,10 @@ REPO = Path(__file__).resolve().parents[2]
 def start_run(out: Path) -> tuple[subprocess.Popen, Path]:
     """A wander run far longer than the test, once it is simulating (its events log, written as
     ``events.jsonl.part`` until the run ends, has grown)."""
-    child = subprocess.Popen([sys.executable, "-m", "teamsim.cli", "run", "wander", "--duration", "3600", "--out",
-                              str(out), "--run-id", "signalled"], cwd=REPO, stdout=subprocess.DEVNULL,
-                             stderr=subprocess.DEVNULL)
+    with (out / "stderr.txt").open("wb") as stderr:  # what it said, should the test fail
+        child = subprocess.Popen([sys.executable, "-m", "teamsim.cli", "run", "wander", "--duration", "3600",
+                                  "--out", str(out), "--run-id", "signalled"], cwd=REPO, stdout=subprocess.DEVNULL,
+                                 stderr=stderr)
     run_dir = out / "wander" / "signalled"
     events = run_dir / "events.jsonl.part"
     for _ in range(600):
@@ -41,7 +42,7 @@ def start_run(out: Path) -> tuple[subprocess.Popen, Path]:
 def test_a_signalled_run_ends_interrupted_with_its_outputs(tmp_path, sent, code, error):
     child, run_dir = start_run(tmp_path)
     child.send_signal(sent)
-    assert child.wait(timeout=60) == code
+    assert child.wait(timeout=60) == code, (tmp_path / "stderr.txt").read_text()[-2000:]
     summary = json.loads((run_dir / "summary.json").read_text())
     assert (summary["status"], summary["error"]) == ("interrupted", error)
     assert 0 < summary["sim_time_s"] < 3600

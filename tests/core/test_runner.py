@@ -93,7 +93,10 @@ def test_nan_state_ends_unstable(tmp_path, monkeypatch):
     result = run_trial(quick_config(tmp_path))
     assert result.status == "unstable"
     assert "non-finite" in result.summary["error"]
-    assert json.loads((result.run_dir / "summary.json").read_text())["status"] == "unstable"
+    summary = json.loads((result.run_dir / "summary.json").read_text())
+    assert summary["status"] == "unstable"
+    assert {"events.jsonl", "trajectory.npz", "timeline.png"} <= set(summary["outputs"])  # every output written
+    assert all((result.run_dir / name).exists() for name in summary["outputs"])
 
 
 def test_mujoco_warning_ends_unstable(tmp_path, monkeypatch):
@@ -122,6 +125,7 @@ def test_atomic_write_keeps_old_file_when_writing_fails(tmp_path, monkeypatch):
     with pytest.raises(OSError):
         write_json(path, {"status": "completed", "padding": "x" * 100000})
     assert json.loads(path.read_text()) == {"status": "running"}
+    assert list(tmp_path.iterdir()) == [path]  # and no temporary file left beside it
 
 
 def test_killed_process_leaves_summary_and_events(tmp_path):

@@ -139,3 +139,74 @@ def test_remove_parks_a_robot_and_revive_brings_it_back_with_a_fresh_controller(
     assert (x, y) == pytest.approx(red.spawn[:2], abs=0.05), "no entry_pose: back at its start"
     assert red.active and red.controller is not first
     assert [e["kind"] for e in fault_events(events)] == ["remove", "revive"]
+
+
+class RoleMission(ScriptedMission):
+    """The scripted team with one run-time role, ``boss``, held by whoever the test says (None: vacant)."""
+    fault_roles = {"boss": "the robot the test names"}
+
+    def __init__(self):
+        super().__init__(0.0, 0.0)
+        self.holder = None
+
+    def role_holder(self, world, role):
+        assert role == "boss"
+        return self.holder
+
+
+def role_world(tmp_path, *faults):
+    mission = RoleMission()
+    world = World(wander_config(tmp_path, params={"robots": 3, "obstacles": 0, "room_size": 30.0}, seed=7,
+                                faults=[parse_fault(f) for f in faults]), mission)
+    events = []
+    world.record = events.append
+    return world, mission, events
+
+
+def test_a_role_is_resolved_when_the_fault_is_due_not_before(tmp_path):
+    world, mission, events = role_world(tmp_path, "kill:@boss@2")
+    mission.holder = "red"
+    advance_seconds(world, 1.0)
+    mission.holder = "green"  # the role changes hands before the fault is due
+    advance_seconds(world, 2.0)
+    assert not world.robots["green"].health.alive and world.robots["red"].health.alive
+    assert fault_events(events) == [{"t": 2.0, "event": "fault", "kind": "kill", "robot": "green", "time": 2.0,
+                                     "target": "@boss"}]
+    assert world.fault_report() == [{"kind": "kill", "robot": "@boss", "time": 2.0, "hit": "green", "hit_at": 2.0}]
+
+
+def test_a_vacant_role_keeps_its_fault_waiting_until_someone_holds_it(tmp_path):
+    world, mission, events = role_world(tmp_path, "kill:@boss@1", "slow:blue@2,factor=0.5")
+    advance_seconds(world, 3.0)
+    assert all(r.health.alive for r in world.robots.values())
+    assert [e["event"] for e in events if e["event"].startswith("fault")] == ["fault-waiting", "fault"]  # logged once
+    assert world.fault_report()[0]["hit"] is None  # (the run would end with the role vacant: hit null)
+    assert world.robots["blue"].health.speed_factor == 0.5, "a waiting fault holds up none after it"
+    mission.holder = "red"
+    advance_seconds(world, 0.5)
+    assert not world.robots["red"].health.alive
+    hit = fault_events(events)[-1]
+    assert (hit["robot"], hit["target"], hit["time"], hit["t"]) == ("red", "@boss", 1.0, 3.0)
+
+
+def test_a_role_held_by_a_dead_robot_is_vacant(tmp_path):
+    world, mission, events = role_world(tmp_path, "kill:red@1", "blind-ir:@boss@2")
+    mission.holder = "red"
+    advance_seconds(world, 3.0)
+    assert world.fault_report()[1]["hit"] is None
+    assert [e["event"] for e in events if e["event"].startswith("fault")] == ["fault", "fault-waiting"]
+
+
+@pytest.mark.parametrize("spec, message", [
+    ("kill:@chief@1", "has no role 'chief'; allowed roles: @boss"),
+    ("break-motor:@boss@1,motor=middle", "(the role may fall to red): motor must be one of left, right"),
+])
+def test_bad_role_faults_are_refused_before_the_run(tmp_path, spec, message):
+    with pytest.raises(ConfigError) as info:
+        role_world(tmp_path, spec)
+    assert message in str(info.value) and "\n" not in str(info.value)
+
+
+def test_a_mission_without_roles_refuses_a_role(tmp_path):
+    with pytest.raises(ConfigError, match=r"wander has no roles a fault may name \(@ROLE"):
+        make_world(tmp_path, ["kill:@leader@1"])

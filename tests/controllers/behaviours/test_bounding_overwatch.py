@@ -195,6 +195,22 @@ def test_a_member_follows_its_leader_while_it_leads_then_overwatches():
     assert done[-1].behaviour == OVERWATCH and done[-1].v == 0.0
 
 
+def test_the_leader_waits_for_a_lagging_follower_only_while_it_gains_ground():
+    """A follower alive and talking but 10 m behind its wedge slot (a broken steering motor: robustness study, seed
+    0) stops its leader; after ``patience`` without gaining 0.5 m the leader goes on, and waits again once it
+    gains ground."""
+    brain = joined_red(patience=5.0)
+    run(brain, 0.3, 2.0, GATHER[0] + (0.0,), b_team)
+    green = lambda t, x=-12.0: [Message("green", t, payload("A", prio=1, at=(x, 2.0, 0.0)))] + b_team(t)
+    waiting = run(brain, 2.0, 6.0, GATHER[0] + (0.0,), green)
+    leading = [c for c in waiting if c.behaviour == LEAD]
+    assert leading and all(c.v == 0.0 for c in leading)
+    going = run(brain, 6.0, 9.0, GATHER[0] + (0.0,), green)
+    assert going[-1].behaviour == LEAD and going[-1].v > 0.0
+    closer = run(brain, 9.0, 10.0, GATHER[0] + (0.0,), lambda t: green(t, x=-11.0))
+    assert closer[-1].v == 0.0
+
+
 def test_the_route_ends_after_its_last_bound():
     k = Knowledge("red", "diffdrive", 0, TAU, 3)
     assert [k.turn() for k.bounds in range(4)] == ["A", "B", "A", None]

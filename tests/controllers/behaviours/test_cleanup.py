@@ -3,6 +3,7 @@ from broadcasts, the report trigger (ch.5), the pose estimate and the go-to and 
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -73,6 +74,30 @@ def _observation(t, fix, wheel_speed, touch=None, ir=None):
     return Observation(time=t, robot="red", ir_raw=np.zeros(len(ir)), ir_range=ir,
                        ir_bearings=np.array([0.0, math.pi / 2, math.pi, -math.pi / 2]), pose=fix,
                        motor_speeds=np.array([wheel_speed, wheel_speed]), touch=touch or {})
+
+
+def test_a_report_due_interrupts_a_fruitless_search_but_not_a_load():
+    """Move-spill yields to a due report only while it sweeps the spill with no load after an empty line: on an
+    exhausted spill the report would otherwise wait for lambda (radio-off seed 200: 1608 s instead of 814 s)."""
+    from teamsim.controllers.behaviours.cleanup import MOVE, CleanupRobot
+    from teamsim.models import build_robot
+
+    brain = CleanupRobot(build_robot("r2", "red"), np.random.default_rng(0))
+    k, move = brain.knowledge, brain.sets[MOVE]
+    k.learn_locations(locations_from_extents(EXTENTS, np.array([-3.2, 0.0]), clearance=0.4))
+    k.delivered()
+    k.just_delivered = False
+    applicable = brain.alliance.definitions[MOVE].applicable
+    obs = Observation(time=100.0, robot="red", ir_raw=np.array([]), ir_range=np.array([]), ir_bearings=np.array([]),
+                      pose=None)
+    move.state, move.empty_lines = "sweep", 3
+    assert applicable(obs)  # no report due yet: it searches on
+    obs = replace(obs, time=300.0)  # the report interval has passed since the start
+    assert not applicable(obs)
+    move.empty_lines = 0  # its first line of this activation is still under way
+    assert applicable(obs)
+    move.state, move.empty_lines = "carry", 3  # a load in the jaw is delivered first
+    assert applicable(obs)
 
 
 def test_pose_estimate_is_steadier_than_the_raw_fixes():
@@ -199,7 +224,8 @@ def _tip_range(pose, boxes, half_x=3.96, half_y=1.83, nose=0.2) -> float:
 def _wander_east(boxes, seconds=90.0):
     """Run find-wander's east leg (leg 2) from where its north leg stops, by the west and north walls of the
     7.92 x 3.66 m room, already facing east, kinematically (0.1 s ticks, perfect pose), until the leg ends; the
-    robot's track and the behaviour."""
+    robot's track and the behaviour. ``boxes``: (x0, x1, y0, y1) each, or a function of the time and the pose
+    estimate giving them (an obstacle that moves, and may push the robot)."""
     from teamsim.controllers.behaviours.cleanup import CleanupParams, FindWander
     from teamsim.models import build_robot
 
@@ -220,7 +246,7 @@ def _wander_east(boxes, seconds=90.0):
         if wander.leg != 2:
             break
         ranges = np.full(len(robot.ir_sensors), np.inf)
-        ranges[tips] = _tip_range(estimate.pose, boxes)
+        ranges[tips] = _tip_range(estimate.pose, boxes(tick * 0.1, estimate) if callable(boxes) else boxes)
         estimate.drive(wander(observe(tick * 0.1, ranges)))
         track.append(estimate.pose.copy())
     return np.array(track), wander
@@ -237,6 +263,27 @@ def test_find_wander_sidesteps_a_robot_in_its_way_but_stops_at_the_wall():
     assert (beside > 1.41 - 0.5 - 0.1).all()  # by one sidestep, not more
     # The leg ends at the wall (second sidestep spent, blocked again), not at the time limit.
     assert wander.leg == 3 and track[-1, 0] > 3.4 and len(track) < 600
+
+
+def test_find_wander_does_not_take_a_teammate_that_pushes_it_back_for_the_wall():
+    """A teammate that keeps in the robot's way, moving with its sidesteps and pushing it back west at 10 cm/s while
+    they touch (red following blue's body as a wall in radio-off seed 217), blocks it further back each time: the
+    leg goes on, and reaches the far wall once the teammate has gone (after 30 s), instead of ending at the third
+    block and putting the room's east end at x < 0."""
+    face = [0.3]
+
+    def teammate(time, estimate):
+        if time > 30.0:
+            return []
+        x, y, _ = estimate.pose
+        if face[0] - (x + 0.2) < 0.22:  # touching the jaw: push
+            face[0] -= 0.01
+            estimate.pose[0] -= 0.01
+        return [(face[0], face[0] + 0.35, y - 0.3, y + 0.3)]
+
+    track, wander = _wander_east(teammate, seconds=150.0)
+    assert face[0] < 0.3 - 1.0  # it did push the robot back, round several sidesteps
+    assert wander.leg == 3 and track[-1, 0] > 3.4  # the leg ended at the far wall
 
 
 def test_find_wander_without_obstacles_drives_the_leg_straight_to_the_wall():

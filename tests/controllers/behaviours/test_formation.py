@@ -149,3 +149,70 @@ def test_the_leader_drives_on_while_its_neighbours_keep_up_and_waits_for_one_tha
     assert leader.pace(leader.sense(observation(0.0, (0.0, 0.0, 0.0), sensed), np.zeros(3)), np.zeros(3)) \
         == pytest.approx(share)
     assert command.broadcast == {"waypoint": [10.0, 0.0]}  # strategy III's news rides on every broadcast
+
+
+# -- a failed teammate (ALLIANCE's takeover, spec §1; docs/decisions.md, "Keeping formation") ---------------------
+
+def test_with_robots_failed_each_robot_keeps_its_place_re_links_past_them_and_the_nearest_living_one_leads():
+    no_b = Line(LINE.names, "B", 1.2, frozenset({"B"}))
+    assert no_b.acting == "C"  # A and C are as near B's place: C is nearer the line's middle
+    assert no_b.offset("A") == pytest.approx(1.2)  # places stay: B's is left empty
+    assert no_b.reference("A") == "C" and no_b.reference("D") == "C"
+    assert no_b.neighbours("A") == ("C",) and no_b.neighbours("C") == ("A", "D")
+    assert no_b.sensed("D", "II") == ("C",)  # its neighbour is the acting leader
+    no_c = Line(LINE.names, "B", 1.2, frozenset({"C"}))
+    assert no_c.acting == "B" and no_c.reference("D") == "B" and no_c.neighbours("B") == ("A", "D")
+    assert Line(LINE.names, "B", 1.2, frozenset(LINE.names)).acting is None
+    # The leader's place is found from the acting leader's pose, so every robot's place is where it was.
+    poses = {"C": np.array([2.0, 1.0 - 1.2, 0.0])}
+    assert no_b.lead(poses) == pytest.approx([2.0, 1.0, 0.0])
+    assert place("II", no_b, "D", poses, None, None, 0).point == pytest.approx([2.0, 1.0 - 2.4])
+    assert place("I", no_b, "A", poses, None, None, 0).point == pytest.approx([2.0, 1.0 + 1.2])
+
+
+def test_a_lane_as_waypoints_is_the_route_moved_aside_with_mitred_corners():
+    lane = Lanes(SQUARE).lane(-1.2)  # on the outside of the left turn
+    assert lane == pytest.approx(np.array([(0.0, -1.2), (11.2, -1.2), (11.2, 10.0)]))
+
+
+def heard(time: float, pose, sensed: dict, present) -> Observation:
+    return Observation(time=time, robot="C", ir_raw=np.zeros(10), ir_range=np.full(10, np.inf),
+                       ir_bearings=BEARINGS, pose=PoseFix(*pose, time), motor_speeds=np.zeros(2),
+                       robots_present=frozenset(present), signals={SIGNAL: sensed})
+
+
+def test_a_teammate_silent_on_the_radio_and_standing_still_has_failed_one_that_moves_has_not():
+    follower = KeepFormation(build_robot("diffdrive", "C"), LINE, "IV", KeepFormationParams(),
+                             np.random.default_rng(0), SQUARE)
+    for k in range(30):  # 18 s: B leads on, D stands (dead) and is silent
+        t = 0.6 * k
+        follower.sense(heard(t, (0.18 * k, 0.0, 0.0), {"B": (0.0, 1.2, 0.0, t), "D": (-0.18 * k, -1.2, 0.0, t)},
+                             {"A", "B"}), np.array([0.18 * k, 0.0, 0.0]))
+        if t < 10.0:
+            assert follower.failed == frozenset()
+    assert follower.failed == {"D"}  # dead_after (10 s) of standing silent
+    assert follower.view.neighbours("C") == ("B",) and "D" in follower.sensing()  # still looked at
+    follower.sense(heard(18.0, (5.4, 0.0, 0.0), {}, {"A", "B", "D"}), np.array([5.4, 0.0, 0.0]))
+    assert follower.failed == frozenset()  # heard again (revived)
+
+
+def test_a_robot_that_hears_nobody_doubts_its_radio_not_its_standing_teammates():
+    follower = KeepFormation(build_robot("diffdrive", "C"), LINE, "IV", KeepFormationParams(),
+                             np.random.default_rng(0), SQUARE)
+    for k in range(30):
+        t = 0.6 * k
+        follower.sense(heard(t, (0.0, 0.0, 0.0), {"B": (0.0, 1.2, 0.0, t), "D": (0.0, -1.2, 0.0, t)}, ()),
+                       np.zeros(3))
+    assert follower.failed == frozenset()
+
+
+def test_a_follower_takes_over_follow_route_along_its_own_lane_when_the_leader_is_gone():
+    follower = KeepFormation(build_robot("diffdrive", "C"), LINE, "II", KeepFormationParams(),
+                             np.random.default_rng(0), SQUARE)
+    command = follower(heard(0.0, (0.0, -1.2, 0.0), {"B": (0.0, 1.2, 0.0, 0.0)}, {"A", "B", "D"}))
+    assert command.behaviour == "keep-formation"
+    for t in (1.0, 2.0, 3.0, 3.7):  # B taken out of the arena: neither heard nor seen any more
+        command = follower(heard(t, (0.0, -1.2, 0.0), {}, {"A", "D"}))
+    assert follower.failed == {"B"} and follower.view.acting == "C"
+    assert command.behaviour == "follow-route" and command.broadcast == {"waypoint": [10.0, 0.0]}
+    assert follower.route == pytest.approx(np.array([(0.0, -1.2), (11.2, -1.2), (11.2, 10.0)]))  # its lane

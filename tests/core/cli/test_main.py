@@ -30,6 +30,7 @@ def run_cli(capsys, *argv):
     (["run", "wander", "--fault", "explode:red@3"], "unknown kind 'explode'"),
     (["run", "wander", "--fault", "slow:red@3,factor=2"], "factor must be in (0, 1]"),
     (["run", "wander", "--fault", "kill:mauve@3"], "no robot 'mauve'; team: red, green, blue"),
+    (["run", "wander", "--fault", "kill:@leader@3"], "faults[0] kill:@leader@3: wander has no roles a fault may name"),
     (["run", "wander", "--seed", "x"], "argument --seed: invalid int value: 'x'"),
     (["run", "wander", "--video", "--camera", "nobody"],
      "camera 'nobody' not in the scene; cameras: top, perspective, or a robot's name for its tracking camera: red"),

@@ -3,15 +3,16 @@
 What the thesis describes and these tests check, on a three-waypoint route (the default has five): the eight
 robots split into two groups with two of each kind, a leader emerges in each, and the groups alternate, one
 bounding (its leader leading, the others following) while the other overwatches, until the last bound reaches the
-route's end; with the leader of the bounding group killed mid-bound, a new leader emerges in that group and the
-bounding goes on. Same seed, same trial. Bad input is one line and exit status 2. The 20-seed measurements are in
-docs/bounding-overwatch.md.
+route's end; with the leader of the bounding group killed mid-bound (by its role, ``kill:@leader@T``, resolved when
+the fault is due), a new leader emerges in that group and the bounding goes on. Same seed, same trial. Bad input is
+one line and exit status 2. The measurements over many seeds are in docs/bounding-overwatch.md.
 
 Each trial runs once (functools.cache) and is read by several tests.
 """
 from __future__ import annotations
 
 import functools
+import json
 import math
 from dataclasses import dataclass
 
@@ -102,14 +103,18 @@ def test_while_one_group_bounds_the_other_overwatches():
 
 
 def leader_kill() -> tuple[str, str, float, Trial]:
-    """The leader of the second bound (found by a run without faults), killed 10 s into that bound."""
+    """The leader of the second bound killed 10 s into that bound, by its role (``kill:@leader@T``: whoever leads
+    the bounding group then); the run without faults says who that is and when the bound starts."""
     _, group, leader, start, _ = completed_bounds(trial().metrics)[1]
     at = round(start + 10.0, 1)
-    return group, leader, at, trial(SEED, f"kill:{leader}@{at}")
+    return group, leader, at, trial(SEED, f"kill:@leader@{at}")
 
 
 def test_a_killed_leader_is_replaced_and_the_bounding_goes_on():
     group, dead, at, t = leader_kill()
+    # The role was resolved when the fault was due: to the leader of the bound under way.
+    assert t.world.fault_report() == [{"kind": "kill", "robot": "@leader", "time": at, "hit": dead, "hit_at": at}]
+    assert t.metrics["gone"] == {dead: at}
     claims = [row for row in t.metrics["leaders"] if row[0] == group and row[1] != dead]
     # Survivors whose impatience crossed within one radio period of the first claim claim too (they had not heard
     # it yet); the earliest claim wins, and the others step down as soon as they hear it.
@@ -146,9 +151,33 @@ def test_same_seed_same_trial():
     (["--set", "robots.red.controller.priority=1"], "robots.green.controller.priority=1: robots.red has it too"),
     (["--set", "per_kind=9"], "per_kind=9"),
     (["--fault", "add-robot:newbie@5,kind=diffdrive"], "--fault add-robot:newbie: the bounding overwatch team is"),
+    (["--fault", "kill:@boss@5"], "faults[0] kill:@boss@5: bounding-overwatch has no role 'boss'; allowed roles: "
+                                  "@leader, @leader:A, @leader:B"),
+    (["--fault", "break-motor:@leader@5,motor=steer"], "(the role may fall to "),  # a diffdrive has no steer motor
+    (["--fault", "revive:@leader@5"], "revive needs a robot's name, not a role"),
 ])
 def test_bad_input_is_one_line_and_exit_2(capsys, tmp_path, argv, fragment):
     code = main(["run", "bounding-overwatch", *argv, "--duration", "1", "--out", str(tmp_path)])
     err = capsys.readouterr().err
     assert code == 2 and err.count("\n") == 1, err
     assert fragment in err
+
+
+def test_a_fault_by_role_waits_for_the_role_and_the_run_records_whom_it_struck(tmp_path):
+    """kill:@leader@0: no leader yet, so it waits; the first leader of the bounding group (A) is struck the moment
+    it claims, and events.jsonl and summary.json name it."""
+    code = main(["run", "bounding-overwatch", "--seed", str(SEED), "--duration", "40", "--fault", "kill:@leader@0",
+                 "--out", str(tmp_path), "--run-id", "x"])
+    run = tmp_path / "bounding-overwatch" / "x"
+    summary = json.loads((run / "summary.json").read_text())
+    events = [json.loads(line) for line in (run / "events.jsonl").read_text().splitlines()]
+    assert code == 1 and summary["status"] == "failed"  # (40 s is too short to finish the route)
+    waiting = [e for e in events if e["event"] == "fault-waiting"]
+    struck = [e for e in events if e["event"] == "fault"]
+    assert len(waiting) == 1 and waiting[0]["t"] == 0.0 and waiting[0]["robot"] == "@leader"
+    assert len(struck) == 1 and struck[0]["target"] == "@leader" and struck[0]["time"] == 0.0
+    dead, at = struck[0]["robot"], struck[0]["t"]
+    assert summary["faults"] == [{"kind": "kill", "robot": "@leader", "time": 0.0, "hit": dead, "hit_at": at}]
+    first = next(row for row in summary["metrics"]["leaders"] if row[0] == "A")
+    assert first[1] == dead and at - first[2] <= 0.2  # (struck at the control tick its claim was made)
+    assert summary["robots"][dead]["alive"] is False

@@ -73,13 +73,15 @@ class Trial:
 
 
 @functools.cache
-def trial(seed: int, duration: float, *faults: str) -> Trial:
+def trial(seed: int, duration: float, *faults: str, advance: float | None = None) -> Trial:
+    """Run for ``duration`` s; given ``advance`` (the mission's target, m), until the box has advanced that far."""
     events = []
-    config = resolve(TrialConfig(mission="box-pushing", params=MISSION.Params(), seed=seed,
+    params = MISSION.Params() if advance is None else MISSION.Params(advance=advance)
+    config = resolve(TrialConfig(mission="box-pushing", params=params, seed=seed,
                                  faults=[parse_fault(f) for f in faults]), MISSION)
     world = World(config, MISSION, events=events.append)
     seen, pushes = set(), []
-    while world.time < duration - 1e-9:
+    while world.time < duration - 1e-9 and not (advance is not None and MISSION.done(world)):
         world.tick()
         for brain in world.scene.info["brains"]:  # a record appears at the tick its push completes
             for record in brain.pushes:
@@ -221,6 +223,40 @@ def test_after_a_revival_the_two_share_the_ends_again():
     assert {p.end for p in red} != {p.end for p in green}
     assert alternate(late)
     assert misplaced(late) == []
+
+
+# -- an R-2 killed where it stands (issue 29) ---------------------------------------------------------------------
+# kill, unlike remove, leaves the dead R-2 at its end, behind the box: the survivor's acquisition of that end meets
+# it. The whole 3 m alone takes a lone R-2 about 1500 s (2.0 mm/s): too slow for a test, so the box need only
+# advance 1 m here; green is killed at 40 s (the box about 0.4 m on).
+KILL = ("kill:green@40",)
+KILL_ADVANCE = 1.0
+
+
+def killed() -> Trial:
+    return trial(SEED, 600.0, *KILL, advance=KILL_ADVANCE)
+
+
+def test_the_survivor_of_a_kill_pushes_past_the_dead_r2_and_the_box_gets_there():
+    """After green is killed (its radio silent from 40 s) red takes the right end over once green's claim lapses
+    (tau after its last message, 9 s) and pushes it from beside the dead R-2, where its fingertips meet it: its
+    first right push is complete well within lambda (60 s), which is how long it was wedged against green before.
+    It then pushes both ends in turn, and the box advances the set 1 m. Measured: the first right push activated
+    at 47.2 s and complete at 61.5 s, 0.26 m right of the middle (the right pushes 0.10-0.58 m right of it, within
+    4 degrees of square), 17 pushes alone, 1 m at 357.7 s."""
+    t = killed()
+    assert t.metrics["advance_m"] >= KILL_ADVANCE and t.world.time < 600.0
+    assert not t.of("green", since=40.0)
+    right = [p for p in t.of("red", since=40.0) if p.end == RIGHT]
+    assert right, "red never pushed the right end"
+    assert right[0].completed < 40.0 + 9.0 + PARAMS.give_up_after, right[0]
+    # it took the right end: pushed it from beside green, at the right half of the box, square to it
+    assert all(p.along < 0.0 and abs(p.heading) < 10.0 for p in right), right
+    alone = t.of("red", since=40.0)
+    assert len(alone) >= 6 and all(a.end != b.end for a, b in pairwise(alone)), alone
+    # no set wedged until lambda gave it up
+    gave_up = [e for e in t.events if e["event"] == "motivation" and e.get("kind") == "acquiescence"]
+    assert not gave_up, gave_up
 
 
 # -- Genghis-II in green's place ---------------------------------------------------------------------------------

@@ -16,6 +16,7 @@ import pytest
 from teamsim.cli import main
 from teamsim.config import TrialConfig
 from teamsim.controllers.behaviours.formation import SIGNAL
+from teamsim.faults import parse_fault
 from teamsim.positioning import wrap_angle
 from teamsim.runner import mission_of, state_digest
 from teamsim.scenario import resolve
@@ -95,6 +96,22 @@ def test_a_crossing_team_drives_across_the_middle_leg_once_its_time_comes():
     before = world.pose(world.robots["X1"])[:2].copy()
     run(world, start_at + 15.0)
     assert np.linalg.norm(world.pose(world.robots["X1"])[:2] - before) > 2.0
+
+
+def test_when_the_leader_is_taken_out_the_nearest_living_robot_leads_on_and_the_rest_keep_their_places():
+    """Seed 0, ``remove:B@74.6`` (docs/results/robustness/report.md): B, the leader, carried out of the arena; it
+    failed at 600 s with the followers sensing B parked outside and nobody leading. Now C, as near B's place as A
+    and nearer the line's middle, takes over follow-route along its own lane within tau plus lost_after, and the
+    living line completes with B's place left empty (130.9 s measured)."""
+    config = resolve(TrialConfig(mission="formation", params=FormationParams(), seed=0), MISSION)
+    config.faults = [parse_fault("remove:B@74.6")]
+    world = run(World(config, MISSION), 250.0)
+    completed, metrics = MISSION.outcome(world)
+    brains = world.scene.info["brains"]
+    assert completed and metrics["mission_time_s"] < 200.0
+    assert brains["C"].route is not None and brains["C"].finished_at is not None  # C led to the route's end
+    assert all(brains[n].failed == {"B"} for n in "ACD")
+    assert metrics["order_broken_s"] <= 5  # 0 s measured
 
 
 def test_same_seed_same_trial():

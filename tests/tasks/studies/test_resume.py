@@ -29,7 +29,8 @@ def _short(config) -> dict:
 
 
 class _KilledAt:
-    """Runs trials with ``run`` until call ``at``, which is interrupted as by Ctrl-C."""
+    """Runs trials with ``run`` until call ``at`` (never if negative), which is interrupted as by Ctrl-C; counts
+    the trials run."""
 
     def __init__(self, run, at: int):
         self.run, self.at, self.calls = run, at, 0
@@ -104,7 +105,8 @@ def test_a_killed_study_resumes_to_the_same_report(name, tmp_path, monkeypatch):
     run_study, where, run, clocks = _studies()[name]
     for module in clocks:
         monkeypatch.setattr(module, "time", _NO_CLOCK)
-    _set(monkeypatch, where, run)
+    whole = _KilledAt(run, at=-1)  # (never killed: counts the trials)
+    _set(monkeypatch, where, whole)
     run_study(tmp_path / "whole", False)
     killed = _KilledAt(run, at=1)
     _set(monkeypatch, where, killed)
@@ -114,7 +116,10 @@ def test_a_killed_study_resumes_to_the_same_report(name, tmp_path, monkeypatch):
     _set(monkeypatch, where, run)
     with pytest.raises(JournalError, match="--resume"):  # not without being asked
         run_study(tmp_path / "resumed", False)
+    resumed = _KilledAt(run, at=-1)
+    _set(monkeypatch, where, resumed)
     run_study(tmp_path / "resumed", True)
+    assert resumed.calls == whole.calls - killed.calls  # only the trials the journal lacked ran again
     for file in ("report.md", "results.csv"):
         assert (tmp_path / "resumed" / file).read_bytes() == (tmp_path / "whole" / file).read_bytes(), file
 

@@ -12,9 +12,9 @@ from teamsim.cli.main import ROBUSTNESS_MISSIONS, main
 from teamsim.config import ConfigError
 from teamsim.faults import FAULT_KINDS
 from teamsim.tasks import MISSIONS as REGISTRY
-from teamsim.tasks.studies.robustness import (COLUMNS, MISSIONS, NOT_SUPPORTED, TYPICAL_S, RobustnessStudy, cause_of,
-                                              cells, faults_of, run_study, seeds_from, team_of,
-                                              trial_configs)
+from teamsim.tasks.studies.robustness import (COLUMNS, MISSIONS, NOT_SUPPORTED, ROLE_TARGETS, TYPICAL_S,
+                                              RobustnessStudy, cause_of, cells, faults_of, run_study, seeds_from,
+                                              team_of, trial_configs)
 
 
 def test_every_mission_and_fault_kind_is_in_the_matrix_or_said_why_not():
@@ -36,6 +36,8 @@ def test_faults_are_drawn_from_the_seeds_within_the_typical_time():
             names = dict(team_of(mission, seed))
             if fault == "add-robot":
                 assert faults[0].robot not in names and faults[0].options["kind"]
+            elif (mission, fault) in ROLE_TARGETS:  # a headline fault by role (kill:@leader@T)
+                assert [f.robot for f in faults] == [ROLE_TARGETS[mission, fault]]
             else:
                 assert all(f.robot in names for f in faults)
             if fault in ("radio-on", "revive"):

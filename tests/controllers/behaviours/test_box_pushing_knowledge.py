@@ -6,11 +6,19 @@ right end was pushed last (at equal times: the push this robot learned of last);
 """
 from __future__ import annotations
 
+import math
+
 import pytest
 
 from teamsim.controllers.alliance.motivation import IDLE, activity_message, announced_task
 from teamsim.controllers.base import Command
-from teamsim.controllers.behaviours.box_pushing import LEFT, RIGHT, PushKnowledge, PushRecord, announce
+from teamsim.controllers.behaviours.box_pushing import (LEFT, RIGHT, BoxPushParams, PushEnd, PushKnowledge,
+                                                        PushRecord, Station, announce)
+from teamsim.controllers.skills.pose_estimate import PoseEstimate
+from teamsim.models import r2
+from teamsim.models.r2 import TIP_IR
+
+ROBOT = r2.build("red")
 
 
 def applicable(k: PushKnowledge) -> set[str]:
@@ -139,3 +147,87 @@ def test_an_active_robot_keeps_its_task_in_the_broadcast():
     assert announced_task(out.broadcast) == "push-right"
     assert out.broadcast["pushed"] == {LEFT: 3.5, RIGHT: 0.0}
     assert (out.v, out.omega, out.behaviour) == (0.3, 0.1, "push-right")
+
+
+# -- acquiring an end with something in the way (no physics: observations made up) --------------------------------
+def follow_observation(time: float, tips: tuple[float, float], speed: float = 0.15, heading: float = -math.pi / 2,
+                       present: frozenset = frozenset()):
+    """An R-2 following the box's back face towards its right end (heading -pi/2, the face 0.15 m to its left),
+    hearing the teammates ``present``."""
+    import numpy as np
+
+    from teamsim.controllers.base import Observation
+    from teamsim.positioning import PoseFix
+
+    ir = np.full(len(ROBOT.ir_sensors), np.inf)
+    ir[ROBOT.ir_sensors.index("ir_left_front")] = 0.15
+    ir[[ROBOT.ir_sensors.index(n) for n in TIP_IR]] = tips
+    wheels = len(ROBOT.drive.left) + len(ROBOT.drive.right)
+    return Observation(time=time, robot="red", ir_raw=np.zeros(len(ir)), ir_range=ir, ir_bearings=ROBOT.ir_bearings,
+                       pose=PoseFix(0.0, -0.1 - speed * time, heading, time),
+                       motor_speeds=np.full(wheels, speed / ROBOT.drive.wheel_radius), velocity=(speed, 0.0),
+                       robots_present=present)
+
+
+def following(params: BoxPushParams) -> tuple[PushEnd, PoseEstimate, Station]:
+    estimate, station = PoseEstimate(ROBOT.drive), Station(None, heading=0.0)
+    return PushEnd(ROBOT, RIGHT, PushKnowledge(), station, estimate, params), estimate, station
+
+
+def test_an_acquisition_blocked_along_the_box_pushes_the_end_from_there():
+    """Something in the fingertips' way while following the box, with no teammate heard (a teammate killed at
+    that end, §6.1.2's failure without the seizure), ends the following: the R-2 backs off a little, turns into
+    the box and pushes there, taking that end; it does not drive on into it (which wedged it until lambda,
+    kill:green@124.4 at seed 0)."""
+    params = BoxPushParams()
+    push, estimate, station = following(params)
+
+    def step(t, tips, **kwargs):
+        obs = follow_observation(t, tips, **kwargs)
+        estimate.update(obs)
+        if push.mark is None:
+            push.state, push.since, push.mark = "follow", t, (t, estimate.pose.copy())
+        return push(obs)
+
+    for t, tips in ((0.0, (math.inf, math.inf)), (0.1, (0.2, 0.21))):  # the face alongside; something ahead, far
+        assert step(t, tips).v > 0 and push.state == "follow"
+    command = step(0.2, (params.block_range - 0.01, params.block_range))
+    assert push.state == "clear" and command.v < 0  # backs off along the box ...
+    blocked_at, t = push.mark[1][:2].copy(), 0.2
+    while push.state == "clear":
+        t += 0.1
+        step(t, (0.1, 0.1), speed=-params.drive.back_speed)
+        assert t < 2.0
+    assert push.state == "turn_in" and station.end is None  # ... by block_backoff ...
+    assert math.dist(estimate.pose[:2], blocked_at) >= params.block_backoff
+    t += 0.1
+    step(t, (0.1, 0.1), speed=0.0, heading=0.0)  # ... turns into the box where it is and takes that end
+    assert push.state == "approach" and station.end == RIGHT
+
+
+def test_blocked_with_a_teammate_heard_it_holds_still_first_then_pushes_from_there():
+    """The robot in the way may be a live teammate standing between the ends (it pushed beside a dead robot that
+    has since been revived): the R-2 first holds still for block_wait (longer than phi, so the teammate's
+    impatience can take the end over), following on if the way clears; blocked for longer (two R-2s met head-on,
+    each waiting for the other), it pushes from where it is."""
+    params = BoxPushParams()
+    push, estimate, station = following(params)
+    heard, near = frozenset({"green"}), (params.block_range / 2, params.block_range / 2)
+
+    def step(t, tips, speed=0.0):
+        obs = follow_observation(t, tips, speed=speed, present=heard)
+        estimate.update(obs)
+        return push(obs)
+
+    step(0.0, (math.inf, math.inf), speed=0.15)
+    push.state, push.since, push.mark = "follow", 0.0, (0.0, estimate.pose.copy())
+    for k in range(1, 20):
+        command = step(0.1 * k, near)
+        assert (command.v, command.omega) == (0.0, 0.0) and push.state == "follow" and station.end is None
+    assert step(2.0, (math.inf, math.inf)).v > 0 and push.state == "follow"  # the way cleared: on it goes
+    t = 2.1
+    while t < 2.1 + params.block_wait - 0.05:  # blocked again: the wait starts afresh
+        assert step(t, near).v == 0.0 and push.state == "follow"
+        t += 0.1
+    t += 0.1
+    assert step(t, near).v < 0 and push.state == "clear"  # waited long enough: backs off to push from there
