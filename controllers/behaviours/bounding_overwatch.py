@@ -42,7 +42,7 @@ GROUPS = ("A", "B")  # A bounds first (the thesis's "first team")
 JOIN, EMERGE, LEAD, FOLLOW, OVERWATCH = "join-group", "emerge-leader", "lead-to-waypoint", "follow-leader", "overwatch"
 SETS = (JOIN, EMERGE, LEAD, FOLLOW, OVERWATCH)  # priority order (the §3.6 tie-break)
 LONG = 1e6  # s: psi and lambda of sets that are never handed over or given up
-PROGRESS = 0.5  # m a lagging follower must gain on its slot for its leader to keep waiting (OverwatchParams.patience)
+PROGRESS = 0.5  # m a stalled teammate must gain to be waited for again (Stalls, OverwatchParams.patience)
 
 
 @dataclass(frozen=True)
@@ -330,6 +330,25 @@ class Driver:
         return self.closest_ahead(obs) < self.params.avoid_range
 
 
+class Stalls:
+    """Per teammate, since when its distance to where it should be has not shrunk by ``PROGRESS``: one that has
+    stalled for ``patience`` seconds is no longer waited for (:meth:`OverwatchRobot._gathered`, ``_lag``)."""
+
+    def __init__(self):
+        self.since: dict[str, tuple[float, float]] = {}  # teammate -> (when it last gained ground, its distance)
+
+    def stalled(self, name: str, now: float, distance: float, patience: float) -> bool:
+        if name not in self.since or distance < self.since[name][1] - PROGRESS:
+            self.since[name] = (now, distance)  # just heard, or it gains ground: wait for it
+        return now - self.since[name][0] > patience
+
+    def forget(self, name: str) -> None:
+        self.since.pop(name, None)
+
+    def clear(self) -> None:
+        self.since.clear()
+
+
 class OverwatchRobot:
     """One robot's controller: ALLIANCE over the five sets of Fig. 6-14 (``observation -> Command``).
 
@@ -353,8 +372,8 @@ class OverwatchRobot:
         self.joins: list[tuple[str, float]] = []  # (group, when) for each decision, switches included
         self.leaderships: list[Record] = []
         self.bound_log: list[Record] = []
-        self.lagging: dict[str, tuple[float, float]] = {}  # follower -> (since when it gained no ground, its lag)
-        self.arriving: dict[str, tuple[float, float]] = {}  # member not yet gathered -> (since, its distance)
+        self.lagging = Stalls()  # followers beyond lag from their slots
+        self.arriving = Stalls()  # members not yet at the gathering point
         fast = {s: MotivationRates(delta_fast=1 / params.set_delay, delta_slow=1 / (10 * params.set_delay),
                                    phi=LONG, psi=LONG, lam=LONG) for s in SETS}
         fast[JOIN] = replace(fast[JOIN], delta_fast=20.0, delta_slow=2.0)  # all activate it at the start
@@ -398,14 +417,12 @@ class OverwatchRobot:
         point = np.array(self.gather[self.group])
         for name, m in k.present().items():
             if m.group != self.group or m.visited:
-                self.arriving.pop(name, None)
+                self.arriving.forget(name)
                 continue
             if m.at is None:
                 return False
             away = float(np.hypot(*(point - np.array(m.at[:2]))))
-            if name not in self.arriving or away < self.arriving[name][1] - PROGRESS:
-                self.arriving[name] = (k.now, away)  # (just heard, or it gains ground)
-            if k.now - self.arriving[name][0] <= p.patience:
+            if not self.arriving.stalled(name, k.now, away, p.patience):
                 return False
         return k.me.visited
 
@@ -534,12 +551,9 @@ class OverwatchRobot:
             if m.at is None:
                 continue
             lag = float(np.hypot(*(self._slot(rank, self.pose) - np.array(m.at[:2]))))
-            best = self.lagging.get(name, (now, lag))[1]
             if lag <= p.lag:
-                self.lagging.pop(name, None)
-            elif lag < best - PROGRESS or name not in self.lagging:
-                self.lagging[name] = (now, lag)  # it gains ground (or just fell behind): wait for it
-            if name in self.lagging and now - self.lagging[name][0] > p.patience:
+                self.lagging.forget(name)
+            elif self.lagging.stalled(name, now, lag, p.patience):
                 continue
             worst = max(worst, lag)
         return worst
