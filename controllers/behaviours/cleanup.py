@@ -46,6 +46,7 @@ from teamsim.controllers.skills.goto import AvoidObstacles, DriveParams, Unstick
 from teamsim.controllers.skills.pose_estimate import PoseEstimate
 from teamsim.models.r2 import TIP_IR
 from teamsim.models.robot import RobotModel
+from teamsim.positioning import wrap_angle
 
 FIND, MOVE, REPORT = "find-locations", "move-spill", "report-progress"
 METHODICAL, WANDER = "find-locations-methodical", "find-locations-wander"
@@ -84,6 +85,12 @@ class CleanupParams:
     spill_radius: float = 0.6  # m: sweep lines pass within this of the believed spill centre
     sweep_overshoot: float = 0.6  # m a sweep line runs past its random point
     sweep_speed: float = 0.2  # m/s while scanning: 2 cm per control period
+    # A sweep that bumps something with the front bumper (a puck beside the jaw, which neither the fingertips nor
+    # the beams see) backs off bump_backoff m and turns look_angle rad each way at look_rate rad/s scanning with
+    # the fingertips: 3 cm per tick past a puck 0.27 m ahead (docs/decisions.md, "Pucks on the bumper")
+    bump_backoff: float = 0.2
+    look_angle: float = 0.5
+    look_rate: float = 0.5
     widen_every: int = 4  # empty sweep lines
     hint_lines: int = 4  # empty sweep lines around where it last had a puck before it searches the spill again
     # consecutive sweep lines without a puck: the spill is gone. By the 32nd the area has widened to 5.4 m, the whole
@@ -403,6 +410,8 @@ class MoveSpill(SetController):
     def restart(self) -> None:
         self.state = "to_spill"
         self.line: tuple | None = None  # (heading, length, time scanning began or None while turning)
+        self.looks: list[float] = []  # headings still to turn to while looking round a bump
+        self.backing_since = 0.0
         self.empty_lines = 0
         self.step: G.Sequence | None = None
         self.drop_point: tuple | None = None
@@ -415,7 +424,7 @@ class MoveSpill(SetController):
     def searching_in_vain(self) -> bool:
         """Sweeping the spill with no load, after a line that found nothing: a report that falls due now wins
         (docs/decisions.md, "A due report interrupts a fruitless search")."""
-        return self.state in ("to_spill", "sweep") and self.empty_lines > 0
+        return self.state in ("to_spill", "sweep", "back_off", "look") and self.empty_lines > 0
 
     def _to_spill(self, obs: Observation) -> Command:
         command = self.go(obs, self._search_centre(), self.params.spill_vicinity)
@@ -440,16 +449,50 @@ class MoveSpill(SetController):
                 return self.drive(0.0, omega)
             self.line = (heading, length, obs.time)
             return self.drive()
-        seen = np.isfinite(obs.ir_range[[self.sensors.tip_left, self.sensors.tip_right]]).any()
-        if seen or any(self.sensors.beams(obs)):  # ahead of the jaw, or already in it
+        if self._sees_something(obs):
             self.line = None
-            g = self.sensors, self.params.gripper
-            return self._begin("pick", [G.Approach(*g), G.Grasp(*g), G.Lift(*g)], obs)
+            return self._begin_pick(obs)
+        if obs.touch.get("bump_front", 0.0) >= p.drive.bump_force:  # pushing what it cannot see: stop
+            self.line, self.state, self.backing_since = None, "back_off", obs.time
+            return self._back_off(obs)
         if obs.time - scanning_since > length / p.sweep_speed:
             self.line = None
             self._nothing_found(obs.time)
             return self.drive(-p.sweep_speed)
         return self.drive(p.sweep_speed)
+
+    def _sees_something(self, obs: Observation) -> bool:
+        """Something ahead of the jaw (a fingertip reading), or already in it (a beam broken)."""
+        seen = np.isfinite(obs.ir_range[[self.sensors.tip_left, self.sensors.tip_right]]).any()
+        return bool(seen or any(self.sensors.beams(obs)))
+
+    def _begin_pick(self, obs: Observation) -> Command:
+        g = self.sensors, self.params.gripper
+        return self._begin("pick", [G.Approach(*g), G.Grasp(*g), G.Lift(*g)], obs)
+
+    def _back_off(self, obs: Observation) -> Command:
+        """Reverse off what the bumper met, then look round for it (:meth:`_look`). Left on the bumper, a puck
+        beside the jaw was pushed 1-2 m into the entrance wall, out of the search's reach (docs/decisions.md,
+        "Pucks on the bumper")."""
+        p = self.params
+        if obs.time - self.backing_since < p.bump_backoff / p.sweep_speed:
+            return self.drive(-p.sweep_speed)
+        heading = self.estimate.pose[2]
+        self.state, self.looks = "look", [heading + p.look_angle, heading - p.look_angle, heading]
+        return self._look(obs)
+
+    def _look(self, obs: Observation) -> Command:
+        """Turn to each of ``looks`` in turn, scanning with the fingertips; a sighting starts a pick-up."""
+        if self._sees_something(obs):
+            return self._begin_pick(obs)
+        while self.looks:
+            error = wrap_angle(self.looks[0] - self.estimate.pose[2])
+            if abs(error) > 0.05:
+                return self.drive(0.0, math.copysign(self.params.look_rate, error))
+            self.looks.pop(0)
+        self.state = "sweep"
+        self._nothing_found(obs.time)
+        return self.drive()
 
     def _nothing_found(self, now: float) -> None:
         """A sweep line brought no puck: it ran its length, or what the fingertips saw could not be picked up (a

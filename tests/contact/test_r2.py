@@ -327,6 +327,31 @@ def test_a_puck_under_the_raised_gripper_is_trapped_and_pushed():
     assert max(o.touch["bump_front"] for o in world.controllers["red"].observations) > 0.0, "the bumper feels it"
 
 
+@pytest.mark.parametrize("side", [0.075, 0.082, -0.075, -0.082])
+def test_a_sweep_that_pushes_a_puck_beside_the_jaw_backs_off_and_picks_it_up(side):
+    """A puck beside the jaw is met by the front bumper; neither the fingertips nor the beams see it. The sweep
+    stops on the bump, backs off, turns to look and picks it up, instead of pushing it along its line (1-2 m into
+    a wall in the cleanup, kill-red seed 214 and break-gripper seed 218)."""
+    from teamsim.controllers.behaviours.cleanup import MOVE, CleanupRobot, locations_from_extents
+
+    brain = CleanupRobot(build("red"), np.random.default_rng(SEED))
+    brain.knowledge.learn_locations(locations_from_extents(np.array([-2.8, 2.8, -2.8, 2.8]), np.array([-2.8, 0.0]),
+                                                           clearance=0.4))
+    move = brain.sets[MOVE]
+    move.state, move.line = "sweep", (0.0, 2.5, None)  # east along y = 0 for 2.5 m
+
+    def sweep(obs):
+        return (0.0, 0.0) if brain.estimate.update(obs) is None else move(obs)
+
+    start = np.array([-1.5, side])
+    world, red = solo(sweep, x=-2.0, pucks=[tuple(start)])
+    run_for(world, 40.0, until=lambda w: move.state == "carry")
+    assert move.state == "carry", f"ended in {move.state}"
+    puck = body_pose(world, "puck0/puck")
+    assert puck[2] > 0.1, "lifted"
+    assert np.hypot(*(puck[:2] - start)) < 0.4, "not pushed along the line"
+
+
 def test_a_puck_knocked_onto_its_side_stops_rolling():
     """Rolling resistance (PuckDims.roll_damping): on its side and rolling at 0.1 m/s, a puck stops within 8 cm
     and stays; without it, it rolled on at constant speed (MuJoCo's contacts here have no rolling friction)."""
