@@ -86,7 +86,11 @@ class BoxPushParams:
     end_overrun: float = 0.04  # m driven on after the side IR loses the face: the end is passed
     end_inset: float = 0.15  # m backed up from there: the robot pushes this far in from the end
     contact_range: float = 0.03  # m: a fingertip reading nearer than this is contact
-    approach_timeout: float = 4.0  # s closing in before pushing anyway
+    approach_timeout: float = 4.0  # s closing in without contact: the box is not there, acquire the end again
+    # approaches in a row that met nothing: the robot cannot reach the box (a broken drive) and withdraws from the
+    # pushes; it stops announcing its end, so its claim lapses (docs/decisions.md, "Box pushing: a robot that
+    # cannot reach the box withdraws")
+    miss_limit: int = 3
     # Contact felt through the wheels (shaft encoders, §2.2.1): driving into the heavy box the R-2 crawls (measured
     # 0.01-0.05 m/s against 0.3 asked), closing in freely it is past this speed within 0.2 s (0.5 m/s^2).
     stall_speed: float = 0.1  # m/s
@@ -163,6 +167,7 @@ class Station:
     """Where an R-2 stands: the end it is at, and the heading that pushes into the box there."""
     end: str | None  # None: between the ends
     heading: float | None = None  # from the compass at the end of each push (the R-2 starts facing its end)
+    misses: int = 0  # approaches in a row that met nothing
 
 
 class PushEnd:
@@ -289,16 +294,20 @@ class PushEnd:
 
     def _approach(self, obs: Observation) -> Command:
         """Close in until contact: a fingertip reads it, the front bumper feels it, or (the fingertips blinded)
-        the wheels crawl against the box; else push after ``approach_timeout`` anyway. (Blinded fingertips once
-        left only the timeout: each push drove into the box for 6 s where the other robot's drove 2 s, and the
-        box turned 90 degrees, blind-ir:green@119.8, seed 0.)"""
+        the wheels crawl against the box. Nothing met within ``approach_timeout``, the box is not there: no push,
+        acquire the end again. (Pushing anyway, an R-2 with a broken motor spinning by its end reported a push
+        every 6.5 s and the box's other end alone was pushed, break-motor:red@111.1, seed 0.)"""
         p = self.params
         closing = obs.time - self.mark[0]
         contact = min(obs.ir_range[self.tips]) < p.contact_range
         crawling = obs.velocity is not None and closing >= p.stall_time and obs.velocity[0] < p.stall_speed
-        if contact or crawling or obs.touch.get("bump_front", 0.0) >= p.drive.bump_force or \
-                closing >= p.approach_timeout:
+        if contact or crawling or obs.touch.get("bump_front", 0.0) >= p.drive.bump_force:
+            self.station.misses = 0
             return self._go("push", obs)
+        if closing >= p.approach_timeout:
+            self.station.misses += 1
+            self.station.end = None
+            return self._go("back_off", obs)
         return self.drive(p.push_speed, self.square(obs))
 
     def _push(self, obs: Observation) -> Command:
@@ -353,7 +362,10 @@ class R2BoxPusher:
         return self.knowledge.pushes
 
     def applicable(self, push: PushEnd) -> bool:
-        return self.knowledge.applicable(push.end) and not push.finished
+        """The opposite end was just pushed, this activation has not pushed yet, and the robot can still reach
+        the box (fewer than ``miss_limit`` approaches in a row met nothing)."""
+        return (self.knowledge.applicable(push.end) and not push.finished
+                and self.station.misses < push.params.miss_limit)
 
     def __call__(self, obs: Observation) -> Command:
         for message in obs.inbox:

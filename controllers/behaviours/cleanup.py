@@ -11,7 +11,8 @@ empty), built from its own sensing and from teammates' broadcasts. The behaviour
   front third of the room (the spill) and the back centre (the goal) from them (:func:`locations_from_extents`).
 - move-spill (Fig. 3-7, :class:`MoveSpill`): applicable while the locations are known and the robot believes
   pucks remain. One activation moves one load: go to the spill, sweep straight lines through it scanning with
-  the fingertip IR, zero in, grasp and lift, carry to the goal, lower and release. Its feedback falls for one
+  the fingertip IR (a front bump stops the line, backs off and looks round), zero in, grasp and lift, carry to
+  the goal, lower and release. Its feedback falls for one
   control period after each delivery (the load is moved), so the robot chooses afresh: that is when
   report-progress, if due, can win (ch.5: "the only time a robot tries to initiate the report-progress task is
   after it has completed the transport of a spill object"). A report that falls due while the robot sweeps the
