@@ -87,9 +87,9 @@ class BoxPushParams:
     end_inset: float = 0.15  # m backed up from there: the robot pushes this far in from the end
     contact_range: float = 0.03  # m: a fingertip reading nearer than this is contact
     approach_timeout: float = 4.0  # s closing in without contact: the box is not there, acquire the end again
-    # approaches in a row that met nothing: the robot cannot reach the box (a broken drive) and withdraws from the
-    # pushes; it stops announcing its end, so its claim lapses (docs/decisions.md, "Box pushing: a robot that
-    # cannot reach the box withdraws")
+    # misses in a row (an approach that met nothing, or an activation that ended without a push): the robot cannot
+    # reach the box (a broken drive) and withdraws from the pushes; it stops announcing its end, so its claim
+    # lapses (docs/decisions.md, "A robot that cannot reach the box withdraws")
     miss_limit: int = 3
     # Contact felt through the wheels (shaft encoders, §2.2.1): driving into the heavy box the R-2 crawls (measured
     # 0.01-0.05 m/s against 0.3 asked), closing in freely it is past this speed within 0.2 s (0.5 m/s^2).
@@ -167,7 +167,7 @@ class Station:
     """Where an R-2 stands: the end it is at, and the heading that pushes into the box there."""
     end: str | None  # None: between the ends
     heading: float | None = None  # from the compass at the end of each push (the R-2 starts facing its end)
-    misses: int = 0  # approaches in a row that met nothing
+    misses: int = 0  # approaches that met nothing and activations that ended without a push, in a row
 
 
 class PushEnd:
@@ -356,16 +356,21 @@ class R2BoxPusher:
                        for name, s in self.sets.items()]
         self.alliance = AllianceController(robot.name, definitions, alliance)
         self.active = IDLE
+        self.miss_limit = params.miss_limit
+
+    @property
+    def withdrawn(self) -> bool:
+        """``miss_limit`` misses in a row: it cannot reach the box, and neither pushes nor claims an end."""
+        return self.station.misses >= self.miss_limit
 
     @property
     def pushes(self) -> list:
         return self.knowledge.pushes
 
     def applicable(self, push: PushEnd) -> bool:
-        """The opposite end was just pushed, this activation has not pushed yet, and the robot can still reach
-        the box (fewer than ``miss_limit`` approaches in a row met nothing)."""
-        return (self.knowledge.applicable(push.end) and not push.finished
-                and self.station.misses < push.params.miss_limit)
+        """The opposite end was just pushed, this activation has not pushed yet, and the robot has not
+        withdrawn."""
+        return self.knowledge.applicable(push.end) and not push.finished and not self.withdrawn
 
     def __call__(self, obs: Observation) -> Command:
         for message in obs.inbox:
@@ -375,9 +380,12 @@ class R2BoxPusher:
         command = self.alliance(obs)
         if command.behaviour != self.active:
             if self.active in self.sets:
-                self.sets[self.active].restart()
+                ended = self.sets[self.active]
+                self.station.misses = 0 if ended.finished else self.station.misses + 1
+                ended.restart()
             self.active = command.behaviour
-        return announce(command, push_task(self.station.end) if self.station.end else None, self.knowledge)
+        standing = push_task(self.station.end) if self.station.end and not self.withdrawn else None
+        return announce(command, standing, self.knowledge)
 
 
 def announce(command: Command, standing_task: str | None, knowledge: PushKnowledge) -> Command:

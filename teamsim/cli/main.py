@@ -153,7 +153,7 @@ def _build_parser() -> argparse.ArgumentParser:
     robust = studies.add_parser("robustness", help="every mission under every fault kind it supports, over seeds "
                                                    "(issue 29)")
     robust.add_argument("--seeds", default="1", metavar="N|A-B", help="trial seeds: N (0..N-1) or a range A-B "
-                                                                      "(default: 1, i.e. 61 runs)")
+                                                                      "(default: 1, i.e. 60 runs)")
     robust.add_argument("--missions", type=_csv_of("mission", ROBUSTNESS_MISSIONS), default=ROBUSTNESS_MISSIONS,
                         help=f"comma-separated (default: all): {','.join(ROBUSTNESS_MISSIONS)}")
     robust.add_argument("--faults", type=_csv_of("fault", FAULT_KINDS), default=FAULT_KINDS,

@@ -231,3 +231,45 @@ def test_blocked_with_a_teammate_heard_it_holds_still_first_then_pushes_from_the
         t += 0.1
     t += 0.1
     assert step(t, near).v < 0 and push.state == "clear"  # waited long enough: backs off to push from there
+
+
+# -- a robot that cannot reach the box (a limp motor) ----------------------------------------------------------------
+def test_an_approach_that_meets_nothing_is_no_push_and_the_end_is_acquired_again():
+    """Closing in for approach_timeout with nothing felt (no fingertip contact, no bump, no crawl: driving freely),
+    the box is not there: no push is recorded, and the robot goes to acquire its end again. (Pushing anyway, an R-2
+    with a limp motor reported a push every 6.5 s and the box turned 120 degrees, break-motor:red@111.1, seed 0.)"""
+    params = BoxPushParams()
+    push, estimate, station = following(params)
+    station.end = RIGHT
+    t = 0.0
+    while push.state in ("start", "approach"):
+        obs = follow_observation(t, (math.inf, math.inf), speed=0.3, heading=0.0)
+        estimate.update(obs)
+        push(obs)
+        t += 0.1
+        assert t < params.approach_timeout + 0.5
+    assert push.state == "back_off" and station.end is None and station.misses == 1
+    assert push.knowledge.pushes == [] and not push.finished
+
+
+def test_after_miss_limit_misses_in_a_row_the_robot_withdraws_and_claims_no_end():
+    """Three activations in a row that ended without a push: the robot neither pushes nor announces its end, so a
+    teammate's impatience is no longer held back by its claim; a push in between sets the count back."""
+    from teamsim.controllers.behaviours.box_pushing import R2BoxPusher
+
+    brain = R2BoxPusher(ROBOT, LEFT, BoxPushParams(), {"green": 30.0})
+    left, right = brain.sets["push-left"], brain.sets["push-right"]
+    assert brain.applicable(left) and not brain.withdrawn
+
+    def activation(finished: bool):
+        brain.active = "push-left"
+        left.state = "done" if finished else "follow"
+        brain.alliance = lambda obs: Command(behaviour=IDLE)  # the set ended: ALLIANCE went idle
+        return brain(follow_observation(0.0, (math.inf, math.inf)))
+
+    for finished in (False, False, True, False, False):
+        activation(finished)
+    assert brain.station.misses == 2 and not brain.withdrawn
+    command = activation(False)
+    assert brain.withdrawn and not brain.applicable(left) and not brain.applicable(right)
+    assert announced_task(command.broadcast) is None  # standing at its end, it claims it no more

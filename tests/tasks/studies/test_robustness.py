@@ -25,6 +25,16 @@ def test_every_mission_and_fault_kind_is_in_the_matrix_or_said_why_not():
     assert len(run) + len(NOT_SUPPORTED) == len(MISSIONS) * len(FAULT_KINDS)
 
 
+def test_the_navigate_robot_has_two_drive_motors_so_a_limp_one_leaves_a_single_input():
+    """Why navigate x break-motor is not run: with one of its robot's two locomotion motors limp, one input is
+    left."""
+    from teamsim.models import build_robot
+
+    assert ("navigate", "break-motor") in NOT_SUPPORTED
+    kinds = {kind for seed in (0, 1, 2) for _, kind in team_of("navigate", seed)}
+    assert kinds and all(len(build_robot(kind, "x").motors) == 2 for kind in kinds)
+
+
 def test_faults_are_drawn_from_the_seeds_within_the_typical_time():
     study = RobustnessStudy(seeds=(0, 1, 2))
     for mission, fault in cells(study):
