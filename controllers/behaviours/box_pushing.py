@@ -168,6 +168,9 @@ class Station:
     end: str | None  # None: between the ends
     heading: float | None = None  # from the compass at the end of each push (the R-2 starts facing its end)
     misses: int = 0  # approaches that met nothing and activations that ended without a push, in a row
+    # teammates whose last message claimed a task (None: not tracked, every teammate heard counts): a withdrawn
+    # teammate claims none, pushes from nowhere, and is no reason to hold still when blocked
+    claimants: frozenset | None = None
 
 
 class PushEnd:
@@ -227,17 +230,18 @@ class PushEnd:
         a fingertip sees something in the way within ``block_range``. Then, with no teammate heard within tau, push
         the end from as near it as the robot got (§6.1.1 "push a little on the right end"): a teammate killed at
         its end stands there, and driving on into it wedged the survivor for lambda (60 s) every time it came for
-        that end (kill:green@124.4, seed 0). With a teammate heard, the robot in the way may be that teammate,
-        pushing from nearer the middle than the end: first hold still for ``block_wait``, longer than phi, so the
-        way can clear or the teammate's impatience take this end over (taking the end at once, a revived R-2 and
-        the survivor pushed the same half of the box and turned it 90 degrees, kill:red@100.5 revive:red@219.7,
-        seed 3); only then push from here (holding still for good, two R-2s met head-on, each waiting for the
-        other, until lambda, again and again: radio-off:green@177.4 radio-on:green@242.4, seed 2)."""
+        that end (kill:green@124.4, seed 0). With a teammate heard claiming a task (a withdrawn one claims none),
+        the robot in the way may be that teammate, pushing from nearer the middle than the end: first hold still
+        for ``block_wait``, longer than phi, so the way can clear or the teammate's impatience take this end over
+        (taking the end at once, a revived R-2 and the survivor pushed the same half of the box and turned it 90
+        degrees, kill:red@100.5 revive:red@219.7, seed 3); only then push from here (holding still for good, two
+        R-2s met head-on, each waiting for the other, until lambda, again and again: radio-off:green@177.4
+        radio-on:green@242.4, seed 2)."""
         p = self.params
         if min(obs.ir_range[self.tips]) < p.block_range:
             if self.blocked_since is None:
                 self.blocked_since = obs.time
-            if obs.robots_present and obs.time - self.blocked_since < p.block_wait:
+            if self._teammate_working(obs) and obs.time - self.blocked_since < p.block_wait:
                 return self.drive()
             return self._go("clear", obs)
         self.blocked_since = None
@@ -261,6 +265,10 @@ class PushEnd:
         if self._moved() >= p.follow_limit:
             return self._go("turn_in", obs)
         return self.drive(p.drive.cruise, turn_to(self.estimate.pose, self.along(), p.drive, 0.02) or 0.0)
+
+    def _teammate_working(self, obs: Observation) -> bool:
+        heard = obs.robots_present
+        return bool(heard if self.station.claimants is None else heard & self.station.claimants)
 
     def _back_in(self, obs: Observation) -> Command:
         if self._moved() >= self.params.end_overrun + self.params.end_inset:
@@ -357,6 +365,7 @@ class R2BoxPusher:
         self.alliance = AllianceController(robot.name, definitions, alliance)
         self.active = IDLE
         self.miss_limit = params.miss_limit
+        self.claiming: dict[str, bool] = {}  # teammate -> whether its last message claimed a task
 
     @property
     def withdrawn(self) -> bool:
@@ -375,6 +384,8 @@ class R2BoxPusher:
     def __call__(self, obs: Observation) -> Command:
         for message in obs.inbox:
             self.knowledge.hear(message.payload)
+            self.claiming[message.sender] = announced_task(message.payload) is not None
+        self.station.claimants = frozenset(name for name, claims in self.claiming.items() if claims)
         if self.estimate.update(obs) is None:
             return Command(behaviour=IDLE)
         command = self.alliance(obs)

@@ -273,3 +273,24 @@ def test_after_miss_limit_misses_in_a_row_the_robot_withdraws_and_claims_no_end(
     command = activation(False)
     assert brain.withdrawn and not brain.applicable(left) and not brain.applicable(right)
     assert announced_task(command.broadcast) is None  # standing at its end, it claims it no more
+
+
+def test_blocked_beside_a_withdrawn_teammate_it_pushes_from_there_at_once():
+    """A withdrawn teammate still talks but claims no task: it is not pushing from anywhere, so it is no reason to
+    hold still (held for block_wait each time, green alone took 110 s a push, break-motor:red@244 seed 9)."""
+    params = BoxPushParams()
+    push, estimate, station = following(params)
+    station.claimants = frozenset()  # green is heard, and claims nothing
+    obs = follow_observation(0.0, (math.inf, math.inf), present=frozenset({"green"}))
+    estimate.update(obs)
+    push(obs)
+    push.state, push.since, push.mark = "follow", 0.0, (0.0, estimate.pose.copy())
+    near = (params.block_range / 2, params.block_range / 2)
+    obs = follow_observation(0.1, near, speed=0.0, present=frozenset({"green"}))
+    estimate.update(obs)
+    assert push(obs).v < 0 and push.state == "clear"
+    station.claimants = frozenset({"green"})  # claiming an end: wait for it first, as before
+    push.state, push.blocked_since = "follow", None
+    obs = follow_observation(0.2, near, speed=0.0, present=frozenset({"green"}))
+    estimate.update(obs)
+    assert push(obs).v == 0.0 and push.state == "follow"
