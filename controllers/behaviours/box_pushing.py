@@ -88,8 +88,8 @@ class BoxPushParams:
     contact_range: float = 0.03  # m: a fingertip reading nearer than this is contact
     approach_timeout: float = 4.0  # s closing in without contact: the box is not there, acquire the end again
     # misses in a row (an approach that met nothing, or an activation that ended without a push): the robot cannot
-    # reach the box (a broken drive) and withdraws from the pushes; it stops announcing its end, so its claim
-    # lapses (docs/decisions.md, "A robot that cannot reach the box withdraws")
+    # reach the box (a broken drive) and, while a teammate claims a task, withdraws from the pushes; it stops
+    # announcing its end, so its claim lapses (docs/decisions.md, "A robot that cannot reach the box withdraws")
     miss_limit: int = 3
     # Contact felt through the wheels (shaft encoders, §2.2.1): driving into the heavy box the R-2 crawls (measured
     # 0.01-0.05 m/s against 0.3 asked), closing in freely it is past this speed within 0.2 s (0.5 m/s^2).
@@ -369,8 +369,10 @@ class R2BoxPusher:
 
     @property
     def withdrawn(self) -> bool:
-        """``miss_limit`` misses in a row: it cannot reach the box, and neither pushes nor claims an end."""
-        return self.station.misses >= self.miss_limit
+        """``miss_limit`` misses in a row while a teammate claims a task: it cannot reach the box and leaves the
+        pushes to that teammate, neither pushing nor claiming an end. Alone it keeps trying (a survivor that had
+        lost the box withdrew, and nobody pushed again: break-motor:red@244, seed 9)."""
+        return self.station.misses >= self.miss_limit and bool(self.station.claimants)
 
     @property
     def pushes(self) -> list:

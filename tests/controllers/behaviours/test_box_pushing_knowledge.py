@@ -253,23 +253,31 @@ def test_an_approach_that_meets_nothing_is_no_push_and_the_end_is_acquired_again
 
 
 def test_after_miss_limit_misses_in_a_row_the_robot_withdraws_and_claims_no_end():
-    """Three activations in a row that ended without a push: the robot neither pushes nor announces its end, so a
-    teammate's impatience is no longer held back by its claim; a push in between sets the count back."""
+    """Three activations in a row that ended without a push, with a teammate claiming a task: the robot neither
+    pushes nor announces its end, so the teammate's impatience is no longer held back by its claim; a push in
+    between sets the count back, and with no teammate claiming anything it keeps trying."""
     from teamsim.controllers.behaviours.box_pushing import R2BoxPusher
 
     brain = R2BoxPusher(ROBOT, LEFT, BoxPushParams(), {"green": 30.0})
     left, right = brain.sets["push-left"], brain.sets["push-right"]
     assert brain.applicable(left) and not brain.withdrawn
 
-    def activation(finished: bool):
+    def activation(finished: bool, green_claims: str | None = "push-right"):
+        from dataclasses import replace
+
+        from teamsim.radio import Message
+
         brain.active = "push-left"
         left.state = "done" if finished else "follow"
         brain.alliance = lambda obs: Command(behaviour=IDLE)  # the set ended: ALLIANCE went idle
-        return brain(follow_observation(0.0, (math.inf, math.inf)))
+        heard = [Message("green", 0.0, activity_message(green_claims))]
+        return brain(replace(follow_observation(0.0, (math.inf, math.inf)), inbox=heard))
 
     for finished in (False, False, True, False, False):
         activation(finished)
     assert brain.station.misses == 2 and not brain.withdrawn
+    activation(False, green_claims=None)  # the teammate claims nothing: alone, the robot keeps trying
+    assert brain.station.misses == 3 and not brain.withdrawn and brain.applicable(left)
     command = activation(False)
     assert brain.withdrawn and not brain.applicable(left) and not brain.applicable(right)
     assert announced_task(command.broadcast) is None  # standing at its end, it claims it no more
