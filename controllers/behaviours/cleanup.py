@@ -12,11 +12,11 @@ empty), built from its own sensing and from teammates' broadcasts. The behaviour
 - move-spill (Fig. 3-7, :class:`MoveSpill`): applicable while the locations are known and the robot believes
   pucks remain. One activation moves one load: go to the spill, sweep straight lines through it scanning with
   the fingertip IR (a front bump stops the line, backs off and looks round), zero in, grasp and lift, carry to
-  the goal, lower and release. Its feedback falls for one
-  control period after each delivery (the load is moved), so the robot chooses afresh: that is when
-  report-progress, if due, can win (ch.5: "the only time a robot tries to initiate the report-progress task is
-  after it has completed the transport of a spill object"). A report that falls due while the robot sweeps the
-  spill in vain wins too: on an exhausted spill it would otherwise never come (:attr:`MoveSpill.searching_in_vain`).
+  the goal, lower and release. Its feedback falls for one control period after each delivery (the load is
+  moved), so the robot chooses afresh: that is when report-progress, if due, can win (ch.5: "the only time a
+  robot tries to initiate the report-progress task is after it has completed the transport of a spill object").
+  A report that falls due while the robot sweeps the spill in vain wins too: on an exhausted spill it would
+  otherwise never come (:attr:`MoveSpill.searching_in_vain`).
 - report-progress (Fig. 3-8, :class:`ReportProgress`): applicable when a report is due (``report_interval``
   since the last report this robot knows of) and it has delivered since. It drives to the entrance and reports,
   by radio, which satisfies its teammates.
