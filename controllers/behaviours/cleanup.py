@@ -68,10 +68,12 @@ class CleanupParams:
     # s of curving right without the wall before it is sought again straight ahead to the right: a full circle
     # at the lost-wall curve takes 7 s, and a robot pushed 0.4 m off the wall circled on the spot for 1800 s
     wall_lost_time: float = 8.0
-    # find-wander (see FindWander): s of driving per compass direction (a 7.9 m room at 0.3 m/s is 26 s), and at
-    # most wander_leg_limit s per direction in all
-    wander_leg: float = 30.0
-    wander_leg_limit: float = 90.0
+    # find-wander (see FindWander): m of progress along each compass direction (more than the 7.9 m room is long),
+    # and at most wander_leg_limit s per direction in all. A leg cut short puts the room's end where the robot
+    # stood: a wall-following teammate held a wanderer back for up to 86 s (radio off, seeds 108 and 121), so the
+    # limit is twice that (docs/decisions.md, "Wander find")
+    wander_leg: float = 9.0
+    wander_leg_limit: float = 180.0
     # Blocked for wander_patience during a leg (a teammate driving the same way moves on first), find-wander steps
     # wander_sidestep to its right and carries on: a wall stays in the way, a robot is passed (a teammate switched
     # off by the wall ended the leg there and put the goal 1.3 m short). Right is away from the previous leg's
@@ -317,12 +319,12 @@ class FindMethodical(ExtentTracker):
 class FindWander(ExtentTracker):
     """Fig. 3-6: drive west, north, east and south in turn, tracking the extremes reached.
 
-    Parker gives each direction "a fixed time period". Here a leg's clock runs only while the robot drives along
-    it (``wander_leg`` s of driving: more than the room is long), so time lost to teammates in the way does not
-    cut a leg short and put the goal short of the goal zone (measured: three robots wandering from the entrance
-    at once, radio off). A leg also ends at a wall: blocked for ``wander_patience`` it sidesteps to its right and
-    carries on, up to ``wander_sidesteps`` times; blocked once more at the same place along the leg, what is ahead
-    is the room's extent. A robot in the way is passed or moves on, a wall stays. No leg lasts more than
+    Parker gives each direction "a fixed time period". Here a leg ends after ``wander_leg`` m of progress along
+    its heading (more than the room is long), so time lost to teammates in the way or pushing against them does
+    not cut a leg short and put the goal short of the goal zone (measured: three robots wandering from the
+    entrance at once, radio off). A leg also ends at a wall: blocked for ``wander_patience`` it sidesteps to its
+    right and carries on, up to ``wander_sidesteps`` times; blocked once more at the same place along the leg, what
+    is ahead is the room's extent. A robot in the way is passed or moves on, a wall stays. No leg lasts more than
     ``wander_leg_limit`` s."""
     name = WANDER
     HEADINGS = (math.pi, math.pi / 2, 0.0, -math.pi / 2)
@@ -336,8 +338,7 @@ class FindWander(ExtentTracker):
         super().restart()
         self.leg = 0
         self.leg_began: float | None = None
-        self.driven = 0.0  # s driven along this leg
-        self.last_time: float | None = None
+        self.leg_from: np.ndarray | None = None  # where this leg began
         self.sidesteps = 0
         self.sidestep_from: np.ndarray | None = None  # where the current sidestep began
         self.blocked_since: float | None = None
@@ -345,16 +346,16 @@ class FindWander(ExtentTracker):
 
     def next_leg(self, now: float) -> None:
         self.leg += 1
-        self.leg_began, self.driven, self.sidesteps, self.sidestep_from, self.blocked_since = now, 0.0, 0, None, None
+        self.leg_began, self.leg_from = now, self.estimate.pose[:2].copy()
+        self.sidesteps, self.sidestep_from, self.blocked_since = 0, None, None
 
     def __call__(self, obs: Observation) -> Command:
         p = self.params
         if self.leg_began is None:
-            self.leg_began = obs.time
-        dt = 0.0 if self.last_time is None else obs.time - self.last_time
-        self.last_time = obs.time
+            self.leg_began, self.leg_from = obs.time, self.estimate.pose[:2].copy()
         self.track()
-        if self.driven >= p.wander_leg or obs.time - self.leg_began >= p.wander_leg_limit:
+        if self.leg < len(self.HEADINGS) and (self._progress() >= p.wander_leg
+                                              or obs.time - self.leg_began >= p.wander_leg_limit):
             self.next_leg(obs.time)
         if self.leg >= len(self.HEADINGS):
             return self.conclude()
@@ -367,7 +368,6 @@ class FindWander(ExtentTracker):
             return self.drive(0.0, omega)
         if not blocked:
             self.blocked_since = None
-            self.driven += dt
             return self.drive(p.drive.cruise)
         if self.blocked_since is None:
             self.blocked_since = obs.time
@@ -383,6 +383,11 @@ class FindWander(ExtentTracker):
             else:
                 self.next_leg(obs.time)  # a wall
         return self.drive()
+
+    def _progress(self) -> float:
+        """m made good along this leg's heading since it began."""
+        heading = self.HEADINGS[self.leg]
+        return float(np.dot(self.estimate.pose[:2] - self.leg_from, (math.cos(heading), math.sin(heading))))
 
     def _sidestep(self, heading: float, blocked: bool) -> Command:
         """Turn right and drive ``wander_sidestep`` (or until blocked); then the leg's heading is taken again."""

@@ -286,6 +286,20 @@ def test_find_wander_does_not_take_a_teammate_that_pushes_it_back_for_the_wall()
     assert wander.leg == 3 and track[-1, 0] > 3.4  # the leg ended at the far wall
 
 
+def test_find_wander_held_back_by_a_teammate_still_reaches_the_wall():
+    """A teammate pressing against the robot's side (red following blue's body as its wall, radio-off seed 121)
+    holds it to a tenth of its speed for 70 s while it drives unblocked: the leg is measured in progress along
+    its heading, not in time driving, so it reaches the far wall instead of ending near x = -2.6 after 30 s."""
+    def teammate(time, estimate):
+        if time < 70.0 and abs(estimate.pose[2]) < 0.1:  # driving east: held back to 3 cm/s
+            estimate.pose[0] -= 0.027
+        return []
+
+    track, wander = _wander_east(teammate, seconds=150.0)
+    assert track[(np.arange(len(track)) * 0.1) < 70.0, 0].max() < -1.0  # it was held back
+    assert wander.leg == 3 and track[-1, 0] > 3.4  # the leg ended at the far wall
+
+
 def test_find_wander_without_obstacles_drives_the_leg_straight_to_the_wall():
     track, _ = _wander_east([])
     assert track[:, 0].max() > 3.4
