@@ -83,6 +83,10 @@ class BoxPushParams:
     follow_distance: float = 0.15  # m from the side IR to the face while following it
     follow_gain: float = 3.0  # rad of heading bend per m of following error
     follow_bend: float = 0.3  # rad: the most the heading bends from along the box while following it
+    # m: once the face is seen, a side reading this far beyond follow_distance is past the end, the ray reaching
+    # round the corner (measured 0.11-0.14 m along the face, 0.24-0.28 m just past it: steering in on those, a
+    # robot wrapped round the end and turned in 0.17 m beyond it, kill:green@34.8, seed 10)
+    face_lost: float = 0.08
     end_overrun: float = 0.04  # m driven on after the side IR loses the face: the end is passed
     end_inset: float = 0.15  # m backed up from there: the robot pushes this far in from the end
     contact_range: float = 0.03  # m: a fingertip reading nearer than this is contact
@@ -247,7 +251,7 @@ class PushEnd:
         self.blocked_since = None
         side = OPPOSITE[self.end]
         reading = obs.ir_range[self.side_ir[side]]
-        if math.isfinite(reading):
+        if math.isfinite(reading) and not (self.seen and reading > p.follow_distance + p.face_lost):
             # Steer for a heading along the box bent towards it (or away) by the distance error, at most
             # follow_bend: steering on the error alone turned the robot into the face, where the oblique ray reads
             # long and asks for more turn (a robot wedged itself against the box for 60 s, seed 100).
@@ -321,7 +325,8 @@ class PushEnd:
     def _push(self, obs: Observation) -> Command:
         p = self.params
         if obs.time - self.mark[0] >= p.push_time:
-            self.station.heading = float(obs.pose.heading)  # the compass: the encoders slipped while pushing
+            if np.isfinite(obs.ir_range[self.tips]).all():  # square to the face: its normal, by the compass
+                self.station.heading = float(obs.pose.heading)
             return self._go("release", obs)
         return self.drive(p.push_speed, self.square(obs))
 
