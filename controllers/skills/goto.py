@@ -85,6 +85,7 @@ class AvoidObstacles:
         self.until = -math.inf
         self.turn = 0.0
         self.away = 0.0
+        self.spin = 0.0  # turn rate while moving off: non-zero only when hemmed in
         self.back_until = -math.inf
 
     def __call__(self, obs: Observation) -> tuple[float, float] | None:
@@ -92,28 +93,37 @@ class AvoidObstacles:
         bearing = self._threat(obs)
         if bearing is not None and obs.time >= self.back_until:
             ahead = abs(wrap_angle(bearing)) < math.pi / 2
-            self.away = -p.back_speed if ahead else p.back_speed  # move off, away from it
-            self.back_until = obs.time + p.back_time
-            self.until = self.back_until + p.turn_time
             # Away from the side it is on; from dead ahead, to the right (two robots meeting pass left to left).
             if abs(math.sin(bearing)) > 0.2:
                 side = -math.copysign(1.0, bearing)
             else:
                 side = -1.0 if ahead else self.rng.choice((-1.0, 1.0))
             self.turn = side * p.turn_rate
+            # Something too close where it would move off to as well: turn on the spot for turn_time instead.
+            # (Moving off the one and then off the other, an R-2 between delivered pucks and the wall rocked for
+            # 1200 s: docs/decisions.md, "Hemmed in".)
+            hemmed = self._threat(obs, towards=math.pi if ahead else 0.0) is not None
+            self.away, self.spin = (0.0, self.turn) if hemmed else (-p.back_speed if ahead else p.back_speed, 0.0)
+            self.back_until = obs.time + (p.turn_time if hemmed else p.back_time)
+            self.until = self.back_until + (0.0 if hemmed else p.turn_time)
         if obs.time < self.back_until:
-            return self.away, 0.0
+            return self.away, self.spin
         if obs.time < self.until:
             return 0.0, self.turn
         return None
 
-    def _threat(self, obs: Observation) -> float | None:
-        """Body-frame bearing of the nearest thing too close, or None."""
+    def _threat(self, obs: Observation, towards: float | None = None) -> float | None:
+        """Body-frame bearing of the nearest thing too close (only within 60 degrees of ``towards``, if given),
+        or None."""
         p = self.params
+        cone = math.cos(math.pi / 3)
         for name, bearing in self.bumper_bearings.items():
-            if obs.touch.get(name, 0.0) >= p.bump_force:
+            if obs.touch.get(name, 0.0) >= p.bump_force and (towards is None or math.cos(bearing - towards) > cone):
                 return bearing
-        near = np.flatnonzero(obs.ir_range < p.avoid_range)
+        close = obs.ir_range < p.avoid_range
+        if towards is not None:
+            close &= np.cos(self.bearings - towards) > cone
+        near = np.flatnonzero(close)
         if near.size == 0:
             return None
         return float(self.bearings[near[np.argmin(obs.ir_range[near])]])

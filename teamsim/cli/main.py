@@ -24,6 +24,7 @@ ROBUSTNESS_MISSIONS = ("wander", "navigate", "hazardous-waste", "box-pushing", "
                        "bounding-overwatch", "formation")
 
 EXIT_USAGE = 2
+EXIT_INTERRUPTED = 130  # 128 + SIGINT, as a shell reports Ctrl-C
 
 
 class UsageError(Exception):
@@ -363,7 +364,7 @@ def cmd_run(args) -> int:
           f"{s['real_time_factor']}x real time)")
     if s.get("error"):
         print(f"  {s['error']}", file=sys.stderr)
-    return {"completed": 0, "interrupted": 130}.get(result.status, 1)
+    return {"completed": 0, "interrupted": EXIT_INTERRUPTED}.get(result.status, 1)
 
 
 def cmd_view(args) -> int:
@@ -490,6 +491,7 @@ def one_line(message: str) -> str:
 
 def main(argv: list[str] | None = None) -> int:
     parser = _build_parser()
+    args = None
     try:
         args = parser.parse_args(argv)
         return {"run": cmd_run, "list": cmd_list, "render": cmd_render, "export": cmd_export,
@@ -498,6 +500,10 @@ def main(argv: list[str] | None = None) -> int:
     except (UsageError, ConfigError, RenderBackendError) as exc:
         print(f"teamsim: error: {one_line(str(exc))}", file=sys.stderr)
         return EXIT_USAGE
+    except KeyboardInterrupt:  # Ctrl-C, or SIGTERM in a study: the trials that ended are in its journal
+        resume = f": continue it with --resume {args.out}" if getattr(args, "command", None) == "study" else ""
+        print(f"teamsim: interrupted{resume}", file=sys.stderr)
+        return EXIT_INTERRUPTED
     except BrokenPipeError:  # the output went to a program that stopped reading (teamsim list | head)
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())  # no second error at interpreter exit
         return 1

@@ -139,6 +139,20 @@ def test_avoid_backs_off_from_a_front_bump_then_turns_right_and_releases():
     assert avoid(_observation(10.0 + p.back_time + 0.05, None, 0.0))[1] < 0
 
 
+def test_avoid_hemmed_in_front_and_behind_turns_on_the_spot_instead_of_rocking():
+    """Delivered pucks ahead and the wall behind, both within avoid_range (break-gripper seed 119): backing off the
+    one brought the other into range, and moving off that the first, for 1200 s. Now it turns on the spot."""
+    avoid = AvoidObstacles(("a", "b", "c", "d"), np.array([0.0, math.pi / 2, math.pi, -math.pi / 2]), (),
+                           np.random.default_rng(0))
+    p = avoid.params
+    hemmed = [0.1, np.inf, 0.12, np.inf]  # ahead and behind
+    commands = [avoid(_observation(0.1 * k, None, 0.0, ir=hemmed)) for k in range(round(3 * p.turn_time / 0.1))]
+    assert all(v == 0.0 for v, _ in commands)  # it never drives into either
+    assert all(omega < 0 for _, omega in commands)  # dead ahead: it turns right, and keeps turning the same way
+    v, omega = avoid(_observation(10.0, None, 0.0, ir=[0.1, np.inf, np.inf, np.inf]))  # ahead only: backs off
+    assert v < 0 and omega == 0.0
+
+
 def _fixes_while_asked(unstick, command, fix_at, seconds, rng, noise=0.0127, heading_noise=0.05):
     """Run ``unstick`` at the control rate with a positioning fix every 0.6 s; the commands it returns."""
     out = []

@@ -184,16 +184,27 @@ def test_robot_outside_the_grid_changes_nothing():
 # ---------------------------------------------------------------- evidence, apply, and the compiled loop
 
 
+def _libm(function):
+    """``function`` (from :mod:`math`: the C library's) elementwise over an array. numpy's own float64 log, exp,
+    sin and cos, which it uses on CPUs with AVX-512, may differ from the C library's in the last bit; the compiled
+    update uses the C library's everywhere, so the oracle does too."""
+    ufunc = np.frompyfunc(function, 1, 1)
+    return lambda a: np.asarray(ufunc(np.asarray(a, float)), dtype=float)
+
+
+log, exp, cos, sin, tan = (_libm(f) for f in (math.log, math.exp, math.cos, math.sin, math.tan))
+
+
 def numpy_update(g, pose, ranges, bearings, *, sensor_radius, centre_offset=0.0, footprint_radius=0.0):
     """The update as numpy arrays over (beams, rows, cols), as it was before it was compiled: the oracle."""
     def logit(q):
-        return np.log(q / (1.0 - q))
+        return log(q / (1.0 - q))
 
     p = g.params
     x, y, heading = (float(v) for v in pose)
     ranges, bearings = np.asarray(ranges, float), np.asarray(bearings, float)
-    cx, cy = x + centre_offset * np.cos(heading), y + centre_offset * np.sin(heading)
-    ux, uy = np.cos(heading + bearings), np.sin(heading + bearings)
+    cx, cy = x + centre_offset * cos(heading), y + centre_offset * sin(heading)
+    ux, uy = cos(heading + bearings), sin(heading + bearings)
     sx, sy = cx + sensor_radius * ux, cy + sensor_radius * uy
     rows, cols = g.window(cx, cy, float(np.max(sensor_radius)) + p.range_max + g.resolution)
     if rows.size == 0 or cols.size == 0:
@@ -202,7 +213,7 @@ def numpy_update(g, pose, ranges, bearings, *, sensor_radius, centre_offset=0.0,
     dx, dy = wx[None] - sx[:, None, None], wy[None] - sy[:, None, None]
     along = dx * ux[:, None, None] + dy * uy[:, None, None]
     across = np.abs(dx * uy[:, None, None] - dy * ux[:, None, None])
-    half_width = np.maximum(along * np.tan(p.beam_angle / 2), g.resolution / 2)
+    half_width = np.maximum(along * tan(p.beam_angle / 2), g.resolution / 2)
     in_beam = (along > 0) & (across <= half_width) & (along <= p.range_max)
     hit = np.isfinite(ranges) & (ranges < p.range_max)
     measured = np.where(hit, ranges, p.range_max)[:, None, None]
@@ -219,7 +230,7 @@ def numpy_update(g, pose, ranges, bearings, *, sensor_radius, centre_offset=0.0,
     if footprint_radius > 0:
         evidence += np.where(np.hypot(wx - cx, wy - cy) <= footprint_radius, logit(np.asarray(p.p_free_near)), 0.0)
     block = np.ix_(rows, cols)
-    posterior = 1.0 / (1.0 + np.exp(-(logit(g.probabilities[block]) + evidence)))
+    posterior = 1.0 / (1.0 + exp(-(logit(g.probabilities[block]) + evidence)))
     g.probabilities[block] = np.clip(posterior, p.p_min, p.p_max)
 
 

@@ -140,6 +140,14 @@ def test_the_cli_resumes_in_the_folder_and_refuses_a_changed_study(tmp_path, mon
     assert "nothing to resume" in capsys.readouterr().err
 
 
+def test_the_cli_interrupted_mid_study_says_in_one_line_how_to_continue(tmp_path, monkeypatch, capsys):
+    monkeypatch.setattr(sweep, "_run_one", _KilledAt(_short, at=0))  # Ctrl-C (or SIGTERM) in the first trial
+    out = tmp_path / "study"
+    assert main(["study", "formation", "--runs", "1", "--duration", "2", "--workers", "1", "--strategies", "I",
+                 "--out", str(out)]) == 130
+    assert capsys.readouterr().err.strip() == f"teamsim: interrupted: continue it with --resume {out}"
+
+
 def test_every_study_subcommand_takes_resume():
     from teamsim.cli.main import _build_parser
 
