@@ -325,7 +325,10 @@ class PushEnd:
     def _push(self, obs: Observation) -> Command:
         p = self.params
         if obs.time - self.mark[0] >= p.push_time:
-            if np.isfinite(obs.ir_range[self.tips]).all():  # square to the face: its normal, by the compass
+            # Both fingertips at the face: square to it, its normal by the compass (the encoders slip while
+            # pushing). Else it pushed a corner and turned with it: the heading it had stays (docs/decisions.md,
+            # "Box pushing: the push heading").
+            if (obs.ir_range[self.tips] < p.contact_range).all():
                 self.station.heading = float(obs.pose.heading)
             return self._go("release", obs)
         return self.drive(p.push_speed, self.square(obs))
@@ -369,15 +372,20 @@ class R2BoxPusher:
                        for name, s in self.sets.items()]
         self.alliance = AllianceController(robot.name, definitions, alliance)
         self.active = IDLE
-        self.miss_limit = params.miss_limit
+        self.miss_limit, self.give_up_after = params.miss_limit, params.give_up_after
         self.claiming: dict[str, bool] = {}  # teammate -> whether its last message claimed a task
+        self.now = 0.0
 
     @property
     def withdrawn(self) -> bool:
-        """``miss_limit`` misses in a row while a teammate claims a task: it cannot reach the box and leaves the
-        pushes to that teammate, neither pushing nor claiming an end. Alone it keeps trying (a survivor that had
-        lost the box withdrew, and nobody pushed again: break-motor:red@244, seed 9)."""
-        return self.station.misses >= self.miss_limit and bool(self.station.claimants)
+        """``miss_limit`` misses in a row while a teammate claims a task and the box is being pushed (a push heard
+        of within lambda): it cannot reach the box and leaves the pushes to that teammate, neither pushing nor
+        claiming an end. Alone it keeps trying (a survivor that had lost the box withdrew, and nobody pushed again:
+        break-motor:red@244, seed 9), and it tries again once nobody has pushed for lambda (a teammate with a
+        broken drive claimed its end for good while the healthy red, which had lost the box, stayed withdrawn:
+        break-motor:green@73.7, seed 1)."""
+        pushed_lately = self.now - max(self.knowledge.pushed_at.values()) < self.give_up_after
+        return self.station.misses >= self.miss_limit and bool(self.station.claimants) and pushed_lately
 
     @property
     def pushes(self) -> list:
@@ -389,6 +397,7 @@ class R2BoxPusher:
         return self.knowledge.applicable(push.end) and not push.finished and not self.withdrawn
 
     def __call__(self, obs: Observation) -> Command:
+        self.now = obs.time
         for message in obs.inbox:
             self.knowledge.hear(message.payload)
             self.claiming[message.sender] = announced_task(message.payload) is not None

@@ -174,6 +174,45 @@ def following(params: BoxPushParams) -> tuple[PushEnd, PoseEstimate, Station]:
     return PushEnd(ROBOT, RIGHT, PushKnowledge(), station, estimate, params), estimate, station
 
 
+@pytest.mark.parametrize("tips, keeps", [((0.0, 0.0), False), ((0.0, 0.12), True), ((0.003, math.inf), True)])
+def test_the_push_heading_is_taken_from_the_compass_only_when_square_to_the_face(tips, keeps):
+    """At the end of a push the compass gives the face's normal only if both fingertips touch it. Pushing the box's
+    corner (one fingertip at it, the other 0.12 m off or seeing nothing) the robot turns with the corner: taken as
+    the push heading, that turn sent a lone survivor round the end to the box's far side (kill:green@34.8, seed
+    10: 16 degrees off, 1.37 m at 1800 s)."""
+    params = BoxPushParams()
+    push, estimate, station = following(params)
+    station.heading = -math.pi / 2
+    obs = follow_observation(0.0, tips, speed=0.02, heading=-math.pi / 2 - 0.3)  # turned 17 degrees while pushing
+    estimate.update(obs)
+    push.state, push.since, push.mark = "push", 0.0, (-params.push_time, estimate.pose.copy())
+    push(obs)
+    assert push.state == "release"
+    assert station.heading == pytest.approx(-math.pi / 2 if keeps else -math.pi / 2 - 0.3)
+
+
+def test_a_side_reading_jumping_past_face_lost_is_the_end_of_the_box():
+    """Following the face at 0.11-0.14 m, the side IR read 0.24-0.28 m just past the box's end (the ray reaching
+    round the corner to the end face); steering in on that, a robot wrapped round the end and turned in 0.17 m
+    beyond it (kill:green@34.8, seed 10). A reading that far past follow_distance ends the face: the robot drives
+    end_overrun on and backs in."""
+    params = BoxPushParams()
+    push, estimate, station = following(params)
+    side = ROBOT.ir_sensors.index("ir_left_front")
+
+    def step(t, reading):
+        obs = follow_observation(t, (math.inf, math.inf))
+        obs.ir_range[side] = reading
+        estimate.update(obs)
+        if push.mark is None:
+            push.state, push.since, push.mark = "follow", t, (t, estimate.pose.copy())
+        return push(obs)
+
+    step(0.0, 0.13)
+    states = [(step(0.1 * k, params.follow_distance + params.face_lost + 0.03), push.state)[1] for k in range(1, 6)]
+    assert states[-1] == "back_in"
+
+
 def test_an_acquisition_blocked_along_the_box_pushes_the_end_from_there():
     """Something in the fingertips' way while following the box, with no teammate heard (a teammate killed at
     that end, §6.1.2's failure without the seizure), ends the following: the R-2 backs off a little, turns into
@@ -281,6 +320,32 @@ def test_after_miss_limit_misses_in_a_row_the_robot_withdraws_and_claims_no_end(
     command = activation(False)
     assert brain.withdrawn and not brain.applicable(left) and not brain.applicable(right)
     assert announced_task(command.broadcast) is None  # standing at its end, it claims it no more
+
+
+def test_a_withdrawn_robot_tries_again_once_nobody_has_pushed_for_lambda():
+    """Withdrawn while a teammate claims an end, the robot comes back when no push has been heard of for lambda:
+    the claiming teammate is not pushing either (its drive broken too, break-motor:green@73.7 seed 1, where the
+    healthy red had lost the box, withdrawn, and both stood still for the rest of the mission)."""
+    from dataclasses import replace
+
+    from teamsim.controllers.behaviours.box_pushing import R2BoxPusher
+    from teamsim.radio import Message
+
+    params = BoxPushParams()
+    brain = R2BoxPusher(ROBOT, LEFT, params, {"green": 30.0})
+    brain.station.misses = params.miss_limit
+    brain.alliance = lambda obs: Command(behaviour=IDLE)
+
+    def heard_at(time: float, pushed_right: float = 0.0):
+        payload = {**activity_message("push-right"), "pushed": {LEFT: 0.0, RIGHT: pushed_right}}
+        brain(replace(follow_observation(time, (math.inf, math.inf)), inbox=[Message("green", time, payload)]))
+
+    heard_at(10.0, pushed_right=10.0)  # green claims its end and pushes it
+    assert brain.withdrawn
+    heard_at(10.0 + params.give_up_after - 1.0, pushed_right=10.0)
+    assert brain.withdrawn
+    heard_at(10.0 + params.give_up_after + 1.0, pushed_right=10.0)  # still claiming, no push for lambda
+    assert not brain.withdrawn and brain.applicable(brain.sets["push-left"])
 
 
 def test_blocked_beside_a_withdrawn_teammate_it_pushes_from_there_at_once():
