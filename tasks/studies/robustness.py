@@ -234,9 +234,9 @@ def work_left(mission: str, metrics: dict) -> str:
     return "the mission's verdict was failure"
 
 
-def cause_of(mission: str, result: dict, kinds: tuple[str, ...] = ()) -> tuple[str, str]:
-    """(class, one-line cause) of a run that did not complete, from its measured result and the kinds of the faults
-    it ran under; ("", "") if it did."""
+def cause_of(mission: str, result: dict, faults: tuple[tuple[str, str], ...] = ()) -> tuple[str, str]:
+    """(class, one-line cause) of a run that did not complete, from its measured result and the faults it ran under
+    ((kind, robot) each); ("", "") if it did."""
     status = result.get("status")
     error = result.get("error") or ""
     if status == "completed":
@@ -251,6 +251,12 @@ def cause_of(mission: str, result: dict, kinds: tuple[str, ...] = ()) -> tuple[s
         return "interrupted", error
     metrics = result.get("metrics") or {}
     left = work_left(mission, metrics)
+    kinds = tuple(kind for kind, _ in faults)
+    manager_lost = [robot for kind, robot in faults if kind in ("kill", "remove")
+                    and (robot.lstrip("@") == "manager" or "manager" in (metrics.get("roles") or {}).get(robot, ()))]
+    if mission == "explore" and manager_lost:
+        return "outside the architecture", (f"{left}; the manager (M1, {manager_lost[0]}) was lost: feedback "
+                                            "coordination and reallocation run on it (Chand §5.6), nothing stands in")
     if mission == "navigate" and metrics.get("failure") == "looping":  # teamsim.tasks.missions.looping
         looping = "disabled drive (a limp motor turns it in circles)" if "break-motor" in kinds else \
             "controller livelock"
@@ -276,7 +282,7 @@ def cause_of(mission: str, result: dict, kinds: tuple[str, ...] = ()) -> tuple[s
 
 def result_row(config: TrialConfig, result: dict) -> dict:
     fault = config.run_id.rsplit("-s", 1)[0]
-    cause_class, cause = cause_of(config.mission, result, tuple(f.kind for f in config.faults))
+    cause_class, cause = cause_of(config.mission, result, tuple((f.kind, f.robot) for f in config.faults))
     sim = result.get("sim_time_s")
     return {"mission": config.mission, "fault": fault, "fault_spec": spec_of(config.faults), "seed": config.seed,
             "status": result.get("status"), "completed": bool(result.get("completed", False)),

@@ -119,7 +119,19 @@ def test_seeds():
 def test_the_cause_of_a_run_that_did_not_complete(mission, result, expected):
     assert cause_of(mission, result) == expected
     if result.get("metrics", {}).get("failure") == "looping":
-        assert cause_of(mission, result, ("break-motor",))[0].startswith("disabled drive")
+        assert cause_of(mission, result, (("break-motor", "red"),))[0].startswith("disabled drive")
+
+
+def test_an_exploration_that_lost_its_manager_is_classed_outside_the_architecture():
+    """explore x remove, seed 0: the drawn robot, Robot3, held M1; nothing was assigned or explored after it went
+    (70 % at 5000 s). Chand's feedback coordination runs on the manager and has no stand-in for it."""
+    result = {"status": "failed", "sim_time_s": 5000.0, "duration_s": 5000.0, "working": ["Robot1"],
+              "moved_m": {"Robot1": 0.0},
+              "metrics": {"explored_share": 0.7, "status": {"UE": 3, "assigned": 3, "PE": 1, "E": 9},
+                          "roles": {"Robot2": ["planner"], "Robot3": ["manager"]}}}
+    kind, cause = cause_of("explore", result, (("remove", "Robot3"),))
+    assert kind == "outside the architecture" and "manager (M1, Robot3)" in cause and cause.startswith("70% explored")
+    assert cause_of("explore", result, (("remove", "Robot2"),))[0] == "time limit, robots stuck"
 
 
 def test_a_navigate_trail_that_ends_on_a_sampling_step_is_classified():
