@@ -7,7 +7,8 @@ of the mission's typical time, :data:`TYPICAL_S`, or of ``duration`` if that is 
 come from a generator seeded by the study seed, the mission, the fault and the trial seed (:func:`faults_of`), so a
 study is reproducible and adding a seed changes no other run. A mission whose headline fault strikes a role rather
 than a robot gets it in that kind's cell (:data:`ROLE_TARGETS`: bounding overwatch's kill is ``kill:@leader@T``,
-issue 29's "overwatch with a leader killed"; the role is resolved when the fault is due). Kinds that only make sense
+issue 29's "overwatch with a leader killed", the role resolved when the fault is due; exploration's is
+``kill:explorer@T``, "an explorer killed", the first explorer of the allocation). Kinds that only make sense
 after another fault are run after it: ``radio-on`` after a ``radio-off`` of the same robot, ``revive`` after a
 ``kill`` or a ``remove`` (drawn).
 
@@ -43,8 +44,9 @@ MISSIONS = ("wander", "navigate", "hazardous-waste", "box-pushing", "explore", "
 TYPICAL_S = {"wander": 60.0, "navigate": 60.0, "hazardous-waste": 400.0, "box-pushing": 450.0, "explore": 1800.0,
              "janitorial": 1200.0, "bounding-overwatch": 250.0, "formation": 300.0}
 SETTINGS = {"explore": ("backend=kinematic",)}  # --set per mission (module docstring)
-# (mission, kind) -> the role that kind strikes instead of a drawn robot (teamsim.faults: resolved at run time)
-ROLE_TARGETS = {("bounding-overwatch", "kill"): "@leader"}
+# (mission, kind) -> the role that kind strikes instead of a drawn robot (@ROLE: resolved when the fault is due;
+# explore's role names: resolved from the allocation before the run)
+ROLE_TARGETS = {("bounding-overwatch", "kill"): "@leader", ("explore", "kill"): "explorer"}
 NEWCOMER = {"wander": "diffdrive", "hazardous-waste": "r2", "box-pushing": "genghis2", "janitorial": "janitor"}
 _NO_GRIPPER = "its robots have no gripper"
 _NO_RADIO = "its robots send no messages, so the radio faults change nothing"
