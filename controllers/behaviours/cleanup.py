@@ -81,6 +81,10 @@ class CleanupParams:
     wander_patience: float = 3.0
     wander_sidestep: float = 0.5
     wander_sidesteps: int = 2
+    # sidesteps blocked before half their length that do not count, per leg: a teammate beside the robot boxes it
+    # in until it moves (kill-red seed 191: green took dead red for the east wall with blue beside it); in a corner
+    # the wall beside it stays, and after these the sidesteps count again
+    wander_boxed: int = 4
     # m: blocked further than this along the leg from where it was first blocked, what blocks it has moved (a
     # teammate), and the sidesteps count afresh: a wall is met at the same place (docs/decisions.md, "Wander find")
     wall_stays: float = 0.2
@@ -340,6 +344,7 @@ class FindWander(ExtentTracker):
         self.leg_began: float | None = None
         self.leg_from: np.ndarray | None = None  # where this leg began
         self.sidesteps = 0
+        self.boxed = 0  # sidesteps this leg that were blocked at once and did not count
         self.sidestep_from: np.ndarray | None = None  # where the current sidestep began
         self.blocked_since: float | None = None
         self.wall_at = 0.0  # how far along the leg's heading it was first blocked (since the sidesteps began)
@@ -347,7 +352,7 @@ class FindWander(ExtentTracker):
     def next_leg(self, now: float) -> None:
         self.leg += 1
         self.leg_began, self.leg_from = now, self.estimate.pose[:2].copy()
-        self.sidesteps, self.sidestep_from, self.blocked_since = 0, None, None
+        self.sidesteps, self.sidestep_from, self.blocked_since, self.boxed = 0, None, None, 0
 
     def __call__(self, obs: Observation) -> Command:
         p = self.params
@@ -395,7 +400,11 @@ class FindWander(ExtentTracker):
         omega = turn_to(self.estimate.pose, heading, p.drive)
         if omega is not None:
             return self.drive(0.0, omega)
-        if blocked or np.hypot(*(self.estimate.pose[:2] - self.sidestep_from)) >= p.wander_sidestep:
+        stepped = float(np.hypot(*(self.estimate.pose[:2] - self.sidestep_from)))
+        if blocked or stepped >= p.wander_sidestep:
+            if stepped < p.wander_sidestep / 2 and self.boxed < p.wander_boxed:
+                self.sidesteps -= 1  # boxed in, a teammate beside it (or a corner): the way past was not tried
+                self.boxed += 1
             self.sidestep_from = None
             return self.drive()
         return self.drive(p.drive.cruise)

@@ -300,6 +300,20 @@ def test_find_wander_does_not_take_a_teammate_that_pushes_it_back_for_the_wall()
     assert wander.leg == 3 and track[-1, 0] > 3.4  # the leg ended at the far wall
 
 
+def test_find_wander_boxed_in_by_a_teammate_beside_it_does_not_take_the_one_ahead_for_the_wall():
+    """Dead red by the north wall ahead, and blue beside the robot on its right for 35 s (kill-red seed 191): every
+    sidestep is blocked before it starts. Counted, two of them and one more block put the room's east end at red
+    (x < 0.8, the goal 1.5 m short of the goal zone); now the first few do not count, and once blue has moved the
+    robot passes red and reaches the far wall."""
+    red = (1.0, 1.35, 1.2, 1.83)
+
+    def world(time, estimate):
+        return [red, (0.2, 0.9, 0.8, 1.15)] if time < 35.0 else [red]
+
+    track, wander = _wander_east(world, seconds=150.0)
+    assert wander.leg == 3 and track[-1, 0] > 3.4
+
+
 def test_find_wander_held_back_by_a_teammate_still_reaches_the_wall():
     """A teammate pressing against the robot's side (red following blue's body as its wall, radio-off seed 121)
     holds it to a tenth of its speed for 70 s while it drives unblocked: the leg is measured in progress along
