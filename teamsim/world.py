@@ -102,6 +102,17 @@ def _radio_event(now: float, message) -> dict:
     return {"t": round(now, 6), "event": "radio", "robot": message.sender, "payload": message.payload}
 
 
+def _state_the_arena_extent(arena) -> None:
+    """Write the arena's own extent and centre into its ``<statistic>``, before robots are attached.
+
+    MuJoCo derives them from every body, so robots parked at ``PARKING_X`` would stretch the extent a
+    thousandfold, and with it a renderer's near clip plane (``vis.map.znear`` x extent): the camera would see
+    nothing. The mass and inertia statistics, which scale the solver, are left to the compiler."""
+    stat = mujoco.MjModel.from_xml_string(arena.to_xml_string(), arena.get_assets()).stat
+    arena.statistic.extent = float(stat.extent)
+    arena.statistic.center = [float(c) for c in stat.center]
+
+
 class World:
     def __init__(self, config: TrialConfig, mission, events=None):
         self.config = config
@@ -120,6 +131,8 @@ class World:
             scene = mission.scene(config.scenario, newcomers, timing.physics_dt)
         else:
             scene = mission.build(config.params, self.streams.get("mission", "layout"), newcomers, timing.physics_dt)
+        if any(slot.dormant for slot in scene.robots):
+            _state_the_arena_extent(scene.arena)
         self.robots: dict[str, Robot] = {}
         for slot in scene.robots:
             if slot.name in self.robots:

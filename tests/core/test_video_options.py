@@ -11,6 +11,7 @@ from tests.helpers import wander_config
 
 from teamsim.cli import main
 from teamsim.config import ConfigError, TrialConfig, VideoConfig, apply_setting, validate
+from teamsim.faults import Fault
 from teamsim.gl import RenderBackendError, require_rendering
 
 try:
@@ -92,6 +93,21 @@ def test_the_perspective_camera_frames_the_whole_arena(wander_world, width, heig
         far = pixels[(corners[:, 1] == high[1]) & (corners[:, 2] == 0)]
         assert np.ptp(far[:, 0]) < 0.9 * np.ptp(near[:, 0])
         assert np.mean(frame.max(axis=2) < 20) < 0.01  # floor beyond the arena, not the black void
+    finally:
+        renderer.close()
+
+
+@pytest.mark.parametrize("camera", ["top", "perspective"])
+def test_a_robot_waiting_to_join_does_not_black_out_the_video(tmp_path, camera):
+    """A newcomer waits parked far outside the arena; the frame still shows the arena (it was all black: the parked
+    robot stretched the model's extent, and with it the near clip plane, past the camera)."""
+    config = wander_config(tmp_path, params={"robots": 2}, seed=4)
+    config.faults = [Fault("add-robot", "late", 5.0, {"kind": "diffdrive"})]
+    world = World(config, MISSIONS["wander"])
+    renderer = video.FrameRenderer(world.xml, list(world.robots), 160, 120, camera)
+    try:
+        frame = renderer.render(0.0, world.data.qpos, ["idle"] * 3)
+        assert np.mean(frame.max(axis=2) < 20) < 0.2, "most of the frame is black"
     finally:
         renderer.close()
 
