@@ -44,6 +44,8 @@ KINDS = ("r2", "genghis2")
 STAND_BACK = {"r2": math.hypot(R2Dims().back_x, R2Dims().width / 2) + 0.01,
               "genghis2": math.hypot(Genghis2Dims().length, Genghis2Dims().width) / 2 + 0.01}
 CLEAR = 0.6  # m: an end with a live robot nearer than this is taken, when a robot enters
+WAIT_BACK = 0.8  # m: how much further back than its teammate a robot entering a full team waits ...
+WALL_GAP = 0.03  # m: ... if the room allows, its enclosing circle this clear of the wall (the box starts near one)
 
 
 @dataclass
@@ -83,6 +85,17 @@ def behind_end(box: tuple[float, float, float], dims: BoxDims, end: str, kind: s
     centre = (np.array([x, y]) + along * sign * (dims.length / 2 - inset)
               - normal * (dims.depth / 2 + STAND_BACK[kind]))
     return float(centre[0]), float(centre[1]), yaw
+
+
+def room_behind(pose: tuple[float, float, float], radius: float, room: tuple[float, float]) -> float:
+    """How far a robot at ``pose`` can back away (against its heading) with its enclosing circle, ``radius``,
+    ``WALL_GAP`` clear of the walls of a ``room`` centred on the origin."""
+    x, y, yaw = pose
+    reach = math.inf
+    for at, step, half in ((x, -math.cos(yaw), room[0] / 2), (y, -math.sin(yaw), room[1] / 2)):
+        if abs(step) > 1e-9:
+            reach = min(reach, (math.copysign(half - radius - WALL_GAP, step) - at) / step)
+    return max(0.0, reach)
 
 
 class BoxPushingMission(ScenarioMission):
@@ -195,9 +208,10 @@ class BoxPushingMission(ScenarioMission):
             pose = behind_end(box, dims, end, robot.model.kind, inset)
             if all(math.dist(pose[:2], p) >= CLEAR for p in others):
                 break
-        else:  # both ends taken: wait 0.8 m further back behind its own end
+        else:  # both ends taken: wait behind its own end, WAIT_BACK further back or as far as the wall allows
             end, pose = own, behind_end(box, dims, own, robot.model.kind, inset)
-            pose = (pose[0] - 0.8 * math.cos(box[2]), pose[1] - 0.8 * math.sin(box[2]), box[2])
+            back = min(WAIT_BACK, room_behind(pose, STAND_BACK[robot.model.kind], world.scene.scenario.arena.size))
+            pose = (pose[0] - back * math.cos(box[2]), pose[1] - back * math.sin(box[2]), box[2])
             waiting.add(name)
         world.scene.info["ends"][name] = end
         return pose

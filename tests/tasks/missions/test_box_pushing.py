@@ -298,6 +298,23 @@ def test_genghis_goes_home_once_the_r2_is_gone():
     assert behind > BOX.depth / 2 + STAND_BACK["genghis2"] + 0.5 * PARAMS.home_distance
 
 
+def test_a_robot_joining_a_full_team_at_the_start_waits_in_the_room():
+    """With the box 1 m from the west wall, "0.8 m behind its teammate" is inside the wall: Genghis-II was set down
+    there and lay on its belly against it, whiskers on the floor. It waits as far back as the room allows."""
+    t = trial(SEED, 5.0, "add-robot:genghis@0,kind=genghis2")
+    world, model, genghis = t.world, t.world.model, t.world.robots["genghis"]
+    walls = {model.geom(f"wall_{side}").id for side in ("north", "south", "east", "west")}
+    touching = [{int(world.data.contact.geom1[i]), int(world.data.contact.geom2[i])} for i in range(world.data.ncon)]
+    assert not [pair for pair in touching if pair & walls and pair & set(genghis.geoms.tolist())], "it touches a wall"
+    # standing on its feet behind green, facing the box as green does
+    x, _, heading = world.pose(genghis)
+    gx, _, green_heading = world.pose(world.robots["green"])
+    _, qx, qy, _ = world.data.qpos[genghis.qpos_adr + 3:genghis.qpos_adr + 7]
+    assert 1 - 2 * (qx * qx + qy * qy) > 0.98 and abs(heading - green_heading) < 0.2  # upright, facing the box
+    assert x < gx - (STAND_BACK["genghis2"] + STAND_BACK["r2"] - 0.02)
+    assert t.world.scene.info["waiting"] == {"genghis"}
+
+
 # -- the faults ---------------------------------------------------------------------------------------------------
 def test_remove_and_revive_parse_and_change_health():
     remove, revive = parse_fault("remove:red@60"), parse_fault("revive:red@120")
