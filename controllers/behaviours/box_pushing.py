@@ -111,6 +111,9 @@ class BoxPushParams:
     block_range: float = 0.08  # m
     block_backoff: float = 0.08  # m backed up from it before turning into the box, clear of it while turning
     block_wait: float = 40.0  # s held still first, a teammate heard: longer than phi (r2_patience, 30 s)
+    # Blocked before the side IR has seen the face, the robot stands past the end, its jaw beside the box's end
+    # face: it steps out from the face again (standoff) and follows on, this many times per acquisition.
+    step_outs: int = 2
 
     def rates(self, delta_fast_delay: float, patience: float, teammates: dict[str, float]) -> MotivationRates:
         """One set's rates: theta = 1, delta_slow = 1 / patience for every teammate (its kind's patience)."""
@@ -193,6 +196,7 @@ class PushEnd:
         self.state, self.since, self.mark = "start", None, None
         self.seen, self.lost_at = False, None  # the side IR has seen the face; where it lost it
         self.blocked_since = None  # since when something has been in the way while following
+        self.step_outs = 0  # times it stepped out from the face, blocked before seeing it
 
     def __call__(self, obs: Observation) -> Command:
         if self.since is None:
@@ -240,18 +244,23 @@ class PushEnd:
         (taking the end at once, a revived R-2 and the survivor pushed the same half of the box and turned it 90
         degrees, kill:red@100.5 revive:red@219.7, seed 3); only then push from here (holding still for good, two
         R-2s met head-on, each waiting for the other, until lambda, again and again: radio-off:green@177.4
-        radio-on:green@242.4, seed 2)."""
+        radio-on:green@242.4, seed 2). Blocked before the side IR has seen the face, the robot is past the end and
+        the block is the box's own end face: it steps out from the face and follows again (``_face_box``)."""
         p = self.params
+        side = OPPOSITE[self.end]
+        reading = obs.ir_range[self.side_ir[side]]
+        alongside = math.isfinite(reading) and not (self.seen and reading > p.follow_distance + p.face_lost)
         if min(obs.ir_range[self.tips]) < p.block_range:
+            if not (self.seen or alongside) and self.step_outs < p.step_outs:  # the box's own end ahead
+                self.step_outs += 1
+                return self._go("face_box", obs)
             if self.blocked_since is None:
                 self.blocked_since = obs.time
             if self._teammate_working(obs) and obs.time - self.blocked_since < p.block_wait:
                 return self.drive()
             return self._go("clear", obs)
         self.blocked_since = None
-        side = OPPOSITE[self.end]
-        reading = obs.ir_range[self.side_ir[side]]
-        if math.isfinite(reading) and not (self.seen and reading > p.follow_distance + p.face_lost):
+        if alongside:
             # Steer for a heading along the box bent towards it (or away) by the distance error, at most
             # follow_bend: steering on the error alone turned the robot into the face, where the oblique ray reads
             # long and asks for more turn (a robot wedged itself against the box for 60 s, seed 100).
@@ -269,6 +278,15 @@ class PushEnd:
         if self._moved() >= p.follow_limit:
             return self._go("turn_in", obs)
         return self.drive(p.drive.cruise, turn_to(self.estimate.pose, self.along(), p.drive, 0.02) or 0.0)
+
+    def _face_box(self, obs: Observation) -> Command:
+        """Turn back to the push heading, to back off the face and follow it again. Blocked before the side IR
+        saw the face, the robot stood past the end: it had pushed overhanging it, backed off ``standoff`` with its
+        jaw still beside the box's end face, and turning along met that face. Taken for a teammate in the way, the
+        end was pushed from there under the other end's name, and the next acquisition ran off past the box
+        (kill:green@61.6, seed 24: the box lost at 1.99 m)."""
+        omega = turn_to(self.estimate.pose, self.station.heading, self.params.drive, tolerance=0.05)
+        return self.drive(0.0, omega) if omega is not None else self._go("back_off", obs)
 
     def _teammate_working(self, obs: Observation) -> bool:
         heard = obs.robots_present

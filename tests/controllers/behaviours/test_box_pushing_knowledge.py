@@ -244,6 +244,46 @@ def test_an_acquisition_blocked_along_the_box_pushes_the_end_from_there():
     assert push.state == "approach" and station.end == RIGHT
 
 
+def test_blocked_before_the_face_is_seen_it_steps_out_from_the_face_and_follows_again():
+    """Blocked before the side IR has seen the face, the robot stands past the end with the box's own end face
+    ahead (it pushed overhanging the end, and backing off standoff left its jaw beside it). Taken for a teammate in
+    the way, that end was pushed under the other end's name and the next acquisition ran off past the box
+    (kill:green@61.6, seed 24). It turns back to the push heading, backs off standoff again and follows on; only
+    after step_outs of these does a block end the following."""
+    params = BoxPushParams()
+    push, estimate, station = following(params)
+    side = ROBOT.ir_sensors.index("ir_left_front")
+    t = 0.0
+
+    def step(tips, speed=0.15, heading=-math.pi / 2, face=math.inf):
+        nonlocal t
+        t += 0.1
+        obs = follow_observation(t, tips, speed=speed, heading=heading)
+        obs.ir_range[side] = face  # the face not seen alongside
+        estimate.update(obs)
+        if push.mark is None:
+            push.state, push.since, push.mark = "follow", t, (t, estimate.pose.copy())
+        return push(obs)
+
+    blocked = (params.block_range - 0.02, math.inf)
+    for attempt in range(params.step_outs):
+        step((math.inf, math.inf))
+        assert push.state == "follow"
+        command = step(blocked)
+        assert push.state == "face_box" and command.v == 0.0 and command.omega > 0  # turning back towards heading 0
+        step((math.inf, math.inf), speed=0.0, heading=0.0)  # faces the box: backs off the face
+        assert push.state == "back_off"
+        start = estimate.pose[:2].copy()
+        while push.state == "back_off":
+            assert step((math.inf, math.inf), speed=-params.drive.back_speed, heading=0.0).v <= 0
+        assert push.state == "turn_along" and math.dist(estimate.pose[:2], start) >= params.standoff
+        step((math.inf, math.inf), speed=0.0)  # along the box again: follows
+        assert push.state == "follow" and station.end is None
+    step((math.inf, math.inf))
+    step(blocked)
+    assert push.state == "clear"  # out of step-outs: the block ends the following as before
+
+
 def test_blocked_with_a_teammate_heard_it_holds_still_first_then_pushes_from_there():
     """The robot in the way may be a live teammate standing between the ends (it pushed beside a dead robot that
     has since been revived): the R-2 first holds still for block_wait (longer than phi, so the teammate's
