@@ -177,11 +177,11 @@ def _robot_failure(study: BoxPushingStudy, rows: list[dict]) -> list[str]:
              "about 5 to 8 seconds ...'), the first row; the second times it from green's last push complete, "
              "which, when its news went out, red first answers with one more push at its own end.", "",
              "| what | thesis | teamsim | verdict |", "|---|---|---|---|",
-             f"| takeover pause after green's removal (s) | about 5-8 | {_summary(removal)} | {inside}/{n} in 5-8 s; "
+             f"| takeover pause after green's removal (s) | about 5-8 | {_summary(removal)}; {inside}/{n} in 5-8 s, "
              f"{spread}/{n} within one radio period (3 s) of it | {'yes' if spread == n else 'partly'}: 'about', read "
              "as within a radio period |",
-             f"| the same after green's last push complete (s) | - | {_summary(dead)} | "
-             f"{sum(lo <= p <= hi for p in dead if math.isfinite(p))}/{n} in 5-8 s |",
+             f"| the same after green's last push complete (s) | - | {_summary(dead)}; "
+             f"{sum(lo <= p <= hi for p in dead if math.isfinite(p))}/{n} in 5-8 s | |",
              f"| the same after red's own last push complete (s) | - | {_summary(r['pause_own_s'] for r in rows)} | "
              f"phi = {phi:g} s from green's first message after that push, or tau = {tau:g} s after green's last "
              "message, whichever comes first |",

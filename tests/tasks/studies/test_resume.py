@@ -122,6 +122,23 @@ def test_a_killed_study_resumes_to_the_same_report(name, tmp_path, monkeypatch):
     assert resumed.calls == whole.calls - killed.calls  # only the trials the journal lacked ran again
     for file in ("report.md", "results.csv"):
         assert (tmp_path / "resumed" / file).read_bytes() == (tmp_path / "whole" / file).read_bytes(), file
+    assert malformed_table_rows((tmp_path / "whole" / "report.md").read_text()) == []
+
+
+def malformed_table_rows(markdown: str) -> list[str]:
+    """The rows of the report's markdown tables with another number of cells than their header (a '|' inside a
+    cell's text splits it: the box-pushing report's first row once had five cells under four columns)."""
+    bad, columns = [], None
+    for line in markdown.splitlines():
+        if not line.startswith("|"):
+            columns = None
+            continue
+        cells = line.strip().strip("|").count("|") + 1
+        if columns is None:
+            columns = cells
+        elif cells != columns:
+            bad.append(line)
+    return bad
 
 
 def test_the_cli_resumes_in_the_folder_and_refuses_a_changed_study(tmp_path, monkeypatch, capsys):
