@@ -577,10 +577,15 @@ def check(scenario: Scenario, faults: list[Fault], roles: dict | None = None) ->
     hx, hy = a.size[0] / 2, a.size[1] / 2
     inside = f"inside the {a.size[0]:g} x {a.size[1]:g} m arena"
 
-    def within(path: str, x: float, y: float, margin: float, what: str) -> None:
-        for axis, v, half in (("x", x, hx), ("y", y, hy)):
-            if abs(v) > half - margin + 1e-9:
-                raise ConfigError(f"{path}: {axis}={v:g} must be in [{margin - half:g}, {half - margin:g}] "
+    def within(path: str, x: float, y: float, margin: float | tuple[float, float], what: str) -> None:
+        """(x, y) with ``margin`` (or one per axis: how far the thing reaches either side) inside the arena."""
+        margins = margin if isinstance(margin, tuple) else (margin, margin)
+        for axis, v, half, reach in (("x", x, hx, margins[0]), ("y", y, hy, margins[1])):
+            if reach > half + 1e-9:
+                raise ConfigError(f"{path}: {what} does not fit {inside}: it is {2 * reach:g} m across along "
+                                  f"{axis}")
+            if abs(v) > half - reach + 1e-9:
+                raise ConfigError(f"{path}: {axis}={v:g} must be in [{reach - half:g}, {half - reach:g}] "
                                   f"({what} {inside})")
 
     for group in ("boxes", "cylinders", "bogs"):
@@ -596,7 +601,7 @@ def check(scenario: Scenario, faults: list[Fault], roles: dict | None = None) ->
         half = Obstacle("", b.x, b.y, things.box.depth / 2, things.box.length / 2, b.yaw)
         reach = (abs(half.half_x * math.cos(b.yaw)) + abs(half.half_y * math.sin(b.yaw)),
                  abs(half.half_x * math.sin(b.yaw)) + abs(half.half_y * math.cos(b.yaw)))
-        within(f"objects.boxes[{k}]", b.x, b.y, max(reach), "the whole box")
+        within(f"objects.boxes[{k}]", b.x, b.y, reach, "the whole box")
         solid.append(dataclasses.replace(half, name=f"objects.boxes[{k}]"))
 
     if not scenario.robots:

@@ -41,6 +41,11 @@ RED = {"red": {"pose": [0, 0, 0]}}  # a diffdrive of radius 0.35 m at the centre
      "robots.red.pose: x=3.55 must be in [-3.5, 3.5]"),
     ({"objects": {"pucks": [{"x": 2, "y": 4.1}]}}, "objects.pucks[0]: y=4.1 must be in [-3.9746, 3.9746]"),
     ({"objects": {"boxes": [{"x": 3.8, "y": 0, "yaw": 1.5708}]}}, "objects.boxes[0]: x=3.8 must be in"),
+    # the box's length lies along its own y: at yaw 0 it reaches 0.15 m along x, 0.75 m along y
+    ({"objects": {"boxes": [{"x": 3.9, "y": 0, "yaw": 0}]}}, "objects.boxes[0]: x=3.9 must be in [-3.85, 3.85]"),
+    ({"objects": {"boxes": [{"x": 0, "y": 3.5, "yaw": 0}]}}, "objects.boxes[0]: y=3.5 must be in [-3.25, 3.25]"),
+    ({"objects": {"boxes": [{"x": 0, "y": 0}], "box": {"length": 9}}},
+     "objects.boxes[0]: the whole box does not fit inside the 8 x 8 m arena: it is 9 m across along y"),
     ({"objects": {"pucks": [{"x": 0.2, "y": 0.1}]}}, "robots.red.pose: the robot (radius 0.35 m) overlaps "
                                                      "objects.pucks[0]"),
     ({"arena": {"size": [8, 8], "bogs": [{"x": 5, "y": 0}]}}, "arena.bogs[0]: x=5 must be in [-4, 4]"),
@@ -56,7 +61,8 @@ RED = {"red": {"pose": [0, 0, 0]}}  # a diffdrive of radius 0.35 m at the centre
     ({"robots": {"red": {"options": {"wheels": 3}}}}, "robots.red.options.wheels: unknown option for a diffdrive; "
                                                       "allowed: radius, ir_count"),
     ({"robots": {}}, "robots: a scenario needs at least one robot"),
-    ({"faults": [{"kind": "kill", "robot": "mauve", "time": 1}]}, "faults[0] kill:mauve@1: no robot 'mauve'; team: red"),
+    ({"faults": [{"kind": "kill", "robot": "mauve", "time": 1}]},
+     "faults[0] kill:mauve@1: no robot 'mauve'; team: red"),
     ({"robots": {**RED, "blue": {"pose": [2, 2, 0]}}, "faults": [{"kind": "add-robot", "robot": "blue", "time": 1,
                                                                   "options": {"kind": "tracked"}}]},
      "faults[0] add-robot:blue@1: kind=tracked but robots.blue.kind is diffdrive; allowed: diffdrive"),

@@ -386,6 +386,19 @@ def test_a_genghis_that_does_not_acquire_runs(capsys, tmp_path):
     assert code == 1 and out.startswith("failed: "), err
 
 
+def test_a_box_longer_than_the_room_is_wide_is_rejected(capsys, tmp_path):
+    """The box's length lies across the room (along its own y): 4 m does not fit the 12 ft (3.66 m) room."""
+    shown = tmp_path / "shown.yaml"
+    assert run_cli(capsys, "scenario", "show", "box-pushing", "--output", str(shown))[0] == 0
+    scenario = yaml.safe_load(shown.read_text())
+    scenario["objects"]["box"]["length"] = 4.0
+    path = tmp_path / "long-box.yaml"
+    path.write_text(yaml.safe_dump(scenario))
+    code, _, err = run_cli(capsys, "run", "box-pushing", "--scenario", str(path), "--out", str(tmp_path / "out"))
+    assert_one_line_error(code, err, "objects.boxes[0]: the whole box does not fit inside the 7.9248 x 3.6576 m "
+                                     "arena: it is 4 m across along y")
+
+
 def test_the_rejection_says_how_far_the_box_can_go():
     config = resolve(TrialConfig(mission="box-pushing", params=MISSION.Params(), seed=SEED), MISSION)
     scenario = config.scenario
