@@ -236,6 +236,12 @@ def work_left(mission: str, metrics: dict) -> str:
     return "the mission's verdict was failure"
 
 
+def _manager_lost(faults: tuple[tuple[str, str], ...], roles: dict) -> str | None:
+    """The robot holding exploration's manager role that a kill or remove took, if one did."""
+    return next((robot for kind, robot in faults if kind in ("kill", "remove")
+                 and (robot.lstrip("@") == "manager" or "manager" in roles.get(robot, ()))), None)
+
+
 def cause_of(mission: str, result: dict, faults: tuple[tuple[str, str], ...] = ()) -> tuple[str, str]:
     """(class, one-line cause) of a run that did not complete, from its measured result and the faults it ran under
     ((kind, robot) each); ("", "") if it did."""
@@ -254,10 +260,8 @@ def cause_of(mission: str, result: dict, faults: tuple[tuple[str, str], ...] = (
     metrics = result.get("metrics") or {}
     left = work_left(mission, metrics)
     kinds = tuple(kind for kind, _ in faults)
-    manager_lost = [robot for kind, robot in faults if kind in ("kill", "remove")
-                    and (robot.lstrip("@") == "manager" or "manager" in (metrics.get("roles") or {}).get(robot, ()))]
-    if mission == "explore" and manager_lost:
-        return "outside the architecture", (f"{left}; the manager (M1, {manager_lost[0]}) was lost: feedback "
+    if mission == "explore" and (manager := _manager_lost(faults, metrics.get("roles") or {})):
+        return "outside the architecture", (f"{left}; the manager (M1, {manager}) was lost: feedback "
                                             "coordination and reallocation run on it (Chand §5.6), nothing stands in")
     if mission == "navigate" and metrics.get("failure") == "looping":  # teamsim.tasks.missions.looping
         looping = "disabled drive (a limp motor turns it in circles)" if "break-motor" in kinds else \
