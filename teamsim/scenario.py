@@ -582,8 +582,7 @@ def check(scenario: Scenario, faults: list[Fault], roles: dict | None = None) ->
         margins = margin if isinstance(margin, tuple) else (margin, margin)
         for axis, v, half, reach in (("x", x, hx, margins[0]), ("y", y, hy, margins[1])):
             if reach > half + 1e-9:
-                raise ConfigError(f"{path}: {what} does not fit {inside}: it is {2 * reach:g} m across along "
-                                  f"{axis}")
+                raise ConfigError(f"{path}: does not fit {inside}: {2 * reach:g} m across along {axis}")
             if abs(v) > half - reach + 1e-9:
                 raise ConfigError(f"{path}: {axis}={v:g} must be in [{reach - half:g}, {half - reach:g}] "
                                   f"({what} {inside})")

@@ -105,10 +105,13 @@ def _radio_event(now: float, message) -> dict:
 def _state_the_arena_extent(arena) -> None:
     """Write the arena's own extent and centre into its ``<statistic>``, before robots are attached.
 
-    MuJoCo derives them from every body, so robots parked at ``PARKING_X`` would stretch the extent a
-    thousandfold, and with it a renderer's near clip plane (``vis.map.znear`` x extent): the camera would see
-    nothing. The mass and inertia statistics, which scale the solver, are left to the compiler."""
-    stat = mujoco.MjModel.from_xml_string(arena.to_xml_string(), arena.get_assets()).stat
+    MuJoCo derives them from every body, so robots parked at ``PARKING_X`` would stretch the extent (box
+    pushing: 2018 m against 12 m), and with it a renderer's near clip plane (``vis.map.znear`` x extent): the
+    camera would see nothing. The mass and inertia statistics, which scale the solver, are left to the compiler."""
+    try:
+        stat = mujoco.MjModel.from_xml_string(arena.to_xml_string(), arena.get_assets()).stat
+    except ValueError as exc:
+        raise ConfigError(f"the arena does not compile: {' '.join(str(exc).split())}") from None
     arena.statistic.extent = float(stat.extent)
     arena.statistic.center = [float(c) for c in stat.center]
 

@@ -112,7 +112,7 @@ class BoxPushParams:
     block_backoff: float = 0.08  # m backed up from it before turning into the box, clear of it while turning
     block_wait: float = 40.0  # s held still first, a teammate heard: longer than phi (r2_patience, 30 s)
     # Blocked before the side IR has seen the face, the robot stands past the end, its jaw beside the box's end
-    # face: it steps out from the face again (standoff) and follows on, this many times per acquisition.
+    # face: it steps out from the face again (standoff) and follows on, this many times per activation.
     step_outs: int = 2
 
     def rates(self, delta_fast_delay: float, patience: float, teammates: dict[str, float]) -> MotivationRates:
@@ -196,7 +196,7 @@ class PushEnd:
         self.state, self.since, self.mark = "start", None, None
         self.seen, self.lost_at = False, None  # the side IR has seen the face; where it lost it
         self.blocked_since = None  # since when something has been in the way while following
-        self.step_outs = 0  # times it stepped out from the face, blocked before seeing it
+        self.stepped_out = 0  # times it stepped out from the face, blocked before seeing it
 
     def __call__(self, obs: Observation) -> Command:
         if self.since is None:
@@ -251,8 +251,8 @@ class PushEnd:
         reading = obs.ir_range[self.side_ir[side]]
         alongside = math.isfinite(reading) and not (self.seen and reading > p.follow_distance + p.face_lost)
         if min(obs.ir_range[self.tips]) < p.block_range:
-            if not (self.seen or alongside) and self.step_outs < p.step_outs:  # the box's own end ahead
-                self.step_outs += 1
+            if not (self.seen or alongside) and self.stepped_out < p.step_outs:  # the box's own end ahead
+                self.stepped_out += 1
                 return self._go("face_box", obs)
             if self.blocked_since is None:
                 self.blocked_since = obs.time

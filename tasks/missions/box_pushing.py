@@ -87,14 +87,13 @@ def behind_end(box: tuple[float, float, float], dims: BoxDims, end: str, kind: s
     return float(centre[0]), float(centre[1]), yaw
 
 
-def room_behind(pose: tuple[float, float, float], radius: float, room: tuple[float, float]) -> float:
-    """How far a robot at ``pose`` can back away (against its heading) with its enclosing circle, ``radius``,
-    ``WALL_GAP`` clear of the walls of a ``room`` centred on the origin."""
-    x, y, yaw = pose
+def reach_to_walls(x: float, y: float, heading: float, margin: float, room: tuple[float, float]) -> float:
+    """How far a point at (x, y) can move along ``heading`` and stay ``margin`` inside the walls of a ``room``
+    centred on the origin, m (0 if it is not that far inside now)."""
     reach = math.inf
-    for at, step, half in ((x, -math.cos(yaw), room[0] / 2), (y, -math.sin(yaw), room[1] / 2)):
+    for at, step, half in ((x, math.cos(heading), room[0] / 2), (y, math.sin(heading), room[1] / 2)):
         if abs(step) > 1e-9:
-            reach = min(reach, (math.copysign(half - radius - WALL_GAP, step) - at) / step)
+            reach = min(reach, (math.copysign(max(half - margin, 0.0), step) - at) / step)
     return max(0.0, reach)
 
 
@@ -151,10 +150,7 @@ class BoxPushingMission(ScenarioMission):
     def room_ahead(scenario: Scenario) -> float:
         """How far the box can advance along its normal before its front face meets a wall, m."""
         box, dims = scenario.objects.boxes[0], scenario.objects.box
-        limits = [(math.copysign(half - dims.depth / 2, d) - c) / d if abs(d) > 1e-9 else math.inf
-                  for c, d, half in ((box.x, math.cos(box.yaw), scenario.arena.size[0] / 2),
-                                     (box.y, math.sin(box.yaw), scenario.arena.size[1] / 2))]
-        return max(0.0, min(limits))
+        return reach_to_walls(box.x, box.y, box.yaw, dims.depth / 2, scenario.arena.size)
 
     def scene(self, scenario: Scenario, newcomers, physics_dt: float) -> Scene:
         scene = scene_of(scenario, newcomers, physics_dt)
@@ -210,7 +206,9 @@ class BoxPushingMission(ScenarioMission):
                 break
         else:  # both ends taken: wait behind its own end, WAIT_BACK further back or as far as the wall allows
             end, pose = own, behind_end(box, dims, own, robot.model.kind, inset)
-            back = min(WAIT_BACK, room_behind(pose, STAND_BACK[robot.model.kind], world.scene.scenario.arena.size))
+            room = reach_to_walls(pose[0], pose[1], pose[2] + math.pi, STAND_BACK[robot.model.kind] + WALL_GAP,
+                                  world.scene.scenario.arena.size)
+            back = min(WAIT_BACK, room)
             pose = (pose[0] - back * math.cos(box[2]), pose[1] - back * math.sin(box[2]), box[2])
             waiting.add(name)
         world.scene.info["ends"][name] = end

@@ -6,8 +6,8 @@ the same ``teamsim.network``. A motion that would touch a box,
 a wall or another robot is refused and the robot halted, as a bumper stops it. Terrain (docs/decisions.md,
 "Exploration"): in a bog a robot moves at its traversability times the commanded speed, the physics bog's top
 speed; the drive effort a controller reads is the share of the motors' force the motion needs, as measured on the
-physics robots: ``FIRM_EFFORT`` per unit of speed on firm ground, ``BOG_EFFORT`` / traversability in a bog. Faults: kill and remove
-(the robot stops and falls silent), radio-off, break-motor (it cannot move), slow.
+physics robots: ``FIRM_EFFORT`` per unit of speed on firm ground, ``BOG_EFFORT`` / traversability in a bog.
+Faults: kill and remove (the robot stops and falls silent), radio-off, break-motor (it cannot move), slow.
 """
 from __future__ import annotations
 

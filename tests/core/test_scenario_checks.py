@@ -45,7 +45,7 @@ RED = {"red": {"pose": [0, 0, 0]}}  # a diffdrive of radius 0.35 m at the centre
     ({"objects": {"boxes": [{"x": 3.9, "y": 0, "yaw": 0}]}}, "objects.boxes[0]: x=3.9 must be in [-3.85, 3.85]"),
     ({"objects": {"boxes": [{"x": 0, "y": 3.5, "yaw": 0}]}}, "objects.boxes[0]: y=3.5 must be in [-3.25, 3.25]"),
     ({"objects": {"boxes": [{"x": 0, "y": 0}], "box": {"length": 9}}},
-     "objects.boxes[0]: the whole box does not fit inside the 8 x 8 m arena: it is 9 m across along y"),
+     "objects.boxes[0]: does not fit inside the 8 x 8 m arena: 9 m across along y"),
     ({"objects": {"pucks": [{"x": 0.2, "y": 0.1}]}}, "robots.red.pose: the robot (radius 0.35 m) overlaps "
                                                      "objects.pucks[0]"),
     ({"arena": {"size": [8, 8], "bogs": [{"x": 5, "y": 0}]}}, "arena.bogs[0]: x=5 must be in [-4, 4]"),

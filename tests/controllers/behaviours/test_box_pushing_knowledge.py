@@ -284,6 +284,21 @@ def test_blocked_before_the_face_is_seen_it_steps_out_from_the_face_and_follows_
     assert push.state == "clear"  # out of step-outs: the block ends the following as before
 
 
+def test_blocked_with_the_face_alongside_it_does_not_step_out_and_a_restart_gives_its_step_outs_back():
+    """A block with the side IR reading the face now (the first tick of the following) is something in the way
+    along the face, not the box's end: the old path (clear). And each activation starts with its step-outs."""
+    params = BoxPushParams()
+    push, estimate, station = following(params)
+    obs = follow_observation(0.0, (params.block_range - 0.02, math.inf))  # the face at 0.15 m on the side IR
+    estimate.update(obs)
+    push.state, push.since, push.mark = "follow", 0.0, (0.0, estimate.pose.copy())
+    push(obs)
+    assert push.state == "clear"
+    push.stepped_out = params.step_outs
+    push.restart()
+    assert push.stepped_out == 0 and push.state == "start"
+
+
 def test_blocked_with_a_teammate_heard_it_holds_still_first_then_pushes_from_there():
     """The robot in the way may be a live teammate standing between the ends (it pushed beside a dead robot that
     has since been revived): the R-2 first holds still for block_wait (longer than phi, so the teammate's
