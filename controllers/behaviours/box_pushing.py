@@ -372,10 +372,17 @@ class PushEnd:
 class R2BoxPusher:
     """One R-2's controller: push-knowledge, pose estimate and ALLIANCE over push-left and push-right, its own
     end's set first (only that one if it does not ``acquire`` ends). ``teammates`` maps each teammate to its
-    patience phi (its kind's)."""
+    patience phi (its kind's).
+
+    ``waiting``: set down behind a teammate at its end (add-robot to a full team), as Genghis-II's
+    :class:`GenghisBoxPusher` is. Until its first push it listens for tau before any push, claims no end between
+    pushes, and news of a teammate's newer push at an end takes that end's set's feedback down for a tick (a new
+    episode, so patience phi restarts while that end is being pushed). Without this it drove into its teammate's
+    back 0.4 s after joining and logged that as a push (add-robot:green@0,kind=r2 beside Genghis-II, seed 0)."""
 
     def __init__(self, robot: RobotModel, end: str, params: BoxPushParams, teammates: dict[str, float],
-                 acquires: bool = True, alliance: AllianceParams = AllianceParams()):
+                 acquires: bool = True, alliance: AllianceParams = AllianceParams(), waiting: bool = False):
+        self.tau, self.waiting, self.on_since, self.news_at = alliance.tau, waiting, None, frozenset()
         self.knowledge = PushKnowledge()
         self.estimate = PoseEstimate(robot.drive)
         self.station = Station(end)
@@ -411,14 +418,21 @@ class R2BoxPusher:
 
     def applicable(self, push: PushEnd) -> bool:
         """The opposite end was just pushed, this activation has not pushed yet, and the robot has not
-        withdrawn."""
-        return self.knowledge.applicable(push.end) and not push.finished and not self.withdrawn
+        withdrawn; waiting, it has listened for tau and heard of no newer push at that end this tick."""
+        held = self.waiting and (self.now - self.on_since < self.tau or push.end in self.news_at)
+        return self.knowledge.applicable(push.end) and not push.finished and not self.withdrawn and not held
 
     def __call__(self, obs: Observation) -> Command:
         self.now = obs.time
+        if self.on_since is None:
+            self.on_since = obs.time
+        pushed_before = dict(self.knowledge.pushed_at)
         for message in obs.inbox:
             self.knowledge.hear(message.payload)
             self.claiming[message.sender] = announced_task(message.payload) is not None
+        self.news_at = frozenset(e for e in ENDS if self.knowledge.pushed_at[e] > pushed_before[e])
+        if self.waiting and self.knowledge.pushes:
+            self.waiting = False  # it has pushed: it stands at its end now
         self.station.claimants = frozenset(name for name, claims in self.claiming.items() if claims)
         if self.estimate.update(obs) is None:
             return Command(behaviour=IDLE)
@@ -429,7 +443,7 @@ class R2BoxPusher:
                 self.station.misses = 0 if ended.finished else self.station.misses + 1
                 ended.restart()
             self.active = command.behaviour
-        standing = push_task(self.station.end) if self.station.end and not self.withdrawn else None
+        standing = push_task(self.station.end) if self.station.end and not (self.withdrawn or self.waiting) else None
         return announce(command, standing, self.knowledge)
 
 

@@ -162,12 +162,14 @@ class BoxPushingMission(ScenarioMission):
         settings = scene.scenario.robots[robot.name].controller
         end = scene.info["ends"].get(robot.name, settings.end)
         params = settings.behaviour
+        waiting = robot.name in scene.info.get("waiting", ())
         if robot.kind == "genghis2":
-            brain = GenghisBoxPusher(robot, end, params, waiting=robot.name in scene.info.get("waiting", ()))
+            brain = GenghisBoxPusher(robot, end, params, waiting=waiting)
         else:
             patience = {"r2": params.r2_patience, "genghis2": params.genghis_patience}
             teammates = {n: patience[r.kind] for n, r in scene.scenario.robots.items() if n != robot.name}
-            brain = R2BoxPusher(robot, end, params, teammates, acquires=settings.acquires is not False)
+            brain = R2BoxPusher(robot, end, params, teammates, acquires=settings.acquires is not False,
+                                waiting=waiting)
         scene.info["brains"].append(brain)
         return brain
 

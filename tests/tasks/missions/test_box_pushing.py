@@ -308,6 +308,21 @@ def test_reach_to_walls(x, y, heading, margin, room, reach):
     assert reach_to_walls(x, y, heading, margin, room) == pytest.approx(reach)
 
 
+def test_an_r2_joining_a_full_team_waits_behind_its_teammate_and_takes_the_end_once_it_is_gone():
+    """An R-2 added at 20 s while red and green push is set down behind green (right end). It waits: no push and
+    no claim while green works (it used to drive into its teammate's back at once and log that as a push), and
+    once green is taken away at 50 s it takes the right end over after about tau, as a survivor does (measured:
+    activated at 59.2 s, pushed by 65.3 s)."""
+    t = trial(SEED, 70.0, "add-robot:newr2@20,kind=r2", "remove:green@50")
+    assert t.world.scene.info["ends"]["newr2"] == RIGHT
+    assert not t.of("newr2", until=50.0)
+    assert not [e for e in t.events if e["event"] == "radio" and e["robot"] == "newr2" and 20.0 < e["t"] < 50.0
+                and "push" in str(e["payload"].get("task", ""))], "it claimed an end while waiting"
+    assert len(t.of("green", since=20.0, until=50.0)) >= 3  # green went on pushing its end
+    first = t.of("newr2", since=50.0)
+    assert first and first[0].end == RIGHT and first[0].completed < 50.0 + 25.0
+
+
 def test_a_robot_joining_a_full_team_at_the_start_waits_in_the_room():
     """With the box 1 m from the west wall, "0.8 m behind its teammate" is inside the wall: Genghis-II was set down
     there and lay on its belly against it, whiskers on the floor. It waits as far back as the room allows."""
