@@ -22,9 +22,11 @@ def start_run(out: Path) -> tuple[subprocess.Popen, Path]:
     """A wander run far longer than the test, once it is simulating (its events log, written as
     ``events.jsonl.part`` until the run ends, has grown)."""
     with (out / "stderr.txt").open("wb") as stderr:  # what it said, should the test fail
+        # (SIGINT's default action restored in the child: a shell without job control starts background jobs with
+        # SIGINT ignored, and Python then never raises KeyboardInterrupt; the test must not depend on how it ran)
         child = subprocess.Popen([sys.executable, "-m", "teamsim.cli", "run", "wander", "--duration", "3600",
                                   "--out", str(out), "--run-id", "signalled"], cwd=REPO, stdout=subprocess.DEVNULL,
-                                 stderr=stderr)
+                                 stderr=stderr, preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
     run_dir = out / "wander" / "signalled"
     events = run_dir / "events.jsonl.part"
     for _ in range(600):
