@@ -109,6 +109,32 @@ def covered_cells(obstacle: Obstacle, centres: np.ndarray) -> np.ndarray:
     return obstacle.distance(centres[None, :], centres[:, None]) <= 0
 
 
+class DensityFill:
+    """An occupancy raster filled box by box until it is as near a density as one more box could bring it."""
+
+    def __init__(self, centres: np.ndarray, density: float):
+        self.centres = centres
+        self.occupancy = np.zeros((len(centres), len(centres)), bool)
+        self.target = density * self.occupancy.size
+        self.boxes: list[Box] = []
+
+    def offer(self, box: Box, covered: np.ndarray) -> bool:
+        """Add ``box`` (its cells ``covered``) unless it overshoots; True once the fill is done."""
+        added = np.count_nonzero(covered & ~self.occupancy)  # an overlapping box adds only its new cells
+        if added == 0:
+            return False
+        occupied = np.count_nonzero(self.occupancy)
+        if abs(occupied + added - self.target) >= abs(occupied - self.target):
+            return True
+        self.occupancy |= covered
+        self.boxes.append(box)
+        return False
+
+    @property
+    def layout(self) -> tuple[tuple[Box, ...], np.ndarray]:
+        return tuple(self.boxes), self.occupancy
+
+
 def random_world(density: float, rng: np.random.Generator, params: NavWorldParams = NavWorldParams()) -> NavWorld:
     """A world of the given obstacle density (a fraction), reproducible from ``rng``."""
     return first_passable(density, rng, params, _layout)
@@ -142,30 +168,18 @@ def _layout(density: float, rng: np.random.Generator, params: NavWorldParams,
     layout jams first."""
     half = params.size / 2
     centres = cell_centres(params.size, params.resolution)
-    cells = len(centres)
     lo, hi = params.half_size_range
     mean_area = 4 * ((lo + hi) / 2) ** 2
     strata = max(1, round(math.sqrt(density * params.size ** 2 / mean_area)))
     stratum = params.size / strata
-    target = density * cells * cells
-    occupancy = np.zeros((cells, cells), bool)
-    boxes: list[Box] = []
+    fill = DensityFill(centres, density)
     for _ in range(params.max_rounds):
         for k in rng.permutation(strata * strata):
             row, col = divmod(int(k), strata)
             footprint = _place(rng, params, (-half + col * stratum, -half + row * stratum), stratum,
-                               centres, boxes, keep_clear)
-            if footprint is None:
-                continue
-            box, covered = footprint
-            added = np.count_nonzero(covered & ~occupancy)  # an overlapping box adds only its new cells
-            if added == 0:
-                continue
-            occupied = np.count_nonzero(occupancy)
-            if abs(occupied + added - target) >= abs(occupied - target):
-                return tuple(boxes), occupancy
-            occupancy |= covered
-            boxes.append(box)
+                               centres, fill.boxes, keep_clear)
+            if footprint is not None and fill.offer(*footprint):
+                return fill.layout
     return None
 
 

@@ -24,7 +24,8 @@ import numpy as np
 
 from teamsim.models.arenas import Box
 from teamsim.scenario import Obstacle
-from teamsim.tasks.worlds.navigation import NavWorld, cell_centres, covered_cells, first_passable
+from teamsim.tasks.worlds.navigation import (DensityFill, NavWorld, cell_centres, covered_cells,
+                                               first_passable)
 
 
 @dataclass(frozen=True)
@@ -50,23 +51,14 @@ def _layout(density: float, rng: np.random.Generator, params: UniformWorldParams
             keep_clear) -> tuple[tuple[Box, ...], np.ndarray] | None:
     """Boxes dropped until the density is reached, with their occupancy raster; None if it never is."""
     half = params.size / 2
-    centres = cell_centres(params.size, params.resolution)
-    occupancy = np.zeros((len(centres), len(centres)), bool)
-    target = density * occupancy.size
-    boxes: list[Box] = []
+    fill = DensityFill(cell_centres(params.size, params.resolution), density)
     for _ in range(params.max_boxes):
         hx, hy = rng.uniform(*params.side_range, size=2) / 2
         x, y = rng.uniform(-half + hx, half - hx), rng.uniform(-half + hy, half - hy)
         if any(math.hypot(max(abs(px - x) - hx, 0.0), max(abs(py - y) - hy, 0.0)) < params.clear_radius
                for px, py in keep_clear):
             continue
-        covered = covered_cells(Obstacle("box", x, y, hx, hy), centres)
-        added = np.count_nonzero(covered & ~occupancy)  # a box inside others adds nothing
-        if added == 0:
-            continue
-        occupied = np.count_nonzero(occupancy)
-        if abs(occupied + added - target) >= abs(occupied - target):
-            return tuple(boxes), occupancy
-        occupancy |= covered
-        boxes.append(Box(float(x), float(y), float(hx), float(hy)))
+        covered = covered_cells(Obstacle("box", x, y, hx, hy), fill.centres)
+        if fill.offer(Box(float(x), float(y), float(hx), float(hy)), covered):
+            return fill.layout
     return None
