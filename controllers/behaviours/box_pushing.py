@@ -285,8 +285,12 @@ class PushEnd:
         jaw still beside the box's end face, and turning along met that face. Taken for a teammate in the way, the
         end was pushed from there under the other end's name, and the next acquisition ran off past the box
         (kill:green@61.6, seed 24: the box lost at 1.99 m)."""
+        return self._turn_to_push_heading() or self._go("back_off", obs)
+
+    def _turn_to_push_heading(self) -> Command | None:
+        """A turn on the spot towards the push heading; None once it faces it."""
         omega = turn_to(self.estimate.pose, self.station.heading, self.params.drive, tolerance=0.05)
-        return self.drive(0.0, omega) if omega is not None else self._go("back_off", obs)
+        return None if omega is None else self.drive(0.0, omega)
 
     def _teammate_working(self, obs: Observation) -> bool:
         heard = obs.robots_present
@@ -304,9 +308,9 @@ class PushEnd:
         return self.drive(-self.params.drive.back_speed)
 
     def _turn_in(self, obs: Observation) -> Command:
-        omega = turn_to(self.estimate.pose, self.station.heading, self.params.drive, tolerance=0.05)
-        if omega is not None:
-            return self.drive(0.0, omega)
+        turning = self._turn_to_push_heading()
+        if turning is not None:
+            return turning
         self.station.end = self.end
         return self._go("approach", obs)
 
