@@ -4,6 +4,9 @@
   before the robot's circle touches a point, capped at DC_cdmax;
 - :func:`stops_clear`: ST_v (3.33) by integration, whether the robot, holding a candidate one cycle and then
   braking along its curvature, keeps its circle clear of every point;
+- :func:`best_primary`: the choice by FRC's primary objective (3.35) (RFRC's (3.39)), measuring DC_cd and ST_v
+  only for the candidates that could still win (docs/decisions.md, "The primary objective without measuring
+  every candidate");
 - :func:`thin_to_robot_frame`: the obstacle memory, one point per 2 cm square, in the robot frame.
 - :func:`path_blocked`: HRDU's re-planning trigger, an impassable cell near the path ahead.
 
@@ -28,76 +31,83 @@ def in_place(v: float, omega: float, offset: float) -> bool:
     return abs(v) <= STILL and (abs(omega) <= STILL or abs(offset) <= STILL)
 
 
+@njit(cache=True)
+def _points_outside(px, py, radius, margin, dc_max):
+    """The points' distances from the centre, their indices outside the robot's circle nearest first, and the
+    clearance a candidate that stays in place keeps (the enlarged circle's distance to the nearest point)."""
+    distance = np.hypot(px, py)
+    kept = min(max(distance.min() - (radius + margin), 0.0), dc_max) if px.shape[0] else dc_max
+    # A point at distance d cannot be touched before the centre has travelled d - r, so the search along a
+    # candidate ends at the first point beyond its best.
+    order = np.argsort(distance)
+    return distance, order[distance[order] >= radius], kept
+
+
+@njit(cache=True)
+def _collision_distance(v, omega, px, py, distance, order, radius, margin, offset, dc_max, kept):  # noqa: PLR0913
+    """DC_cd of one candidate (v, omega); ``distance``, ``order``, ``kept`` from ``_points_outside``."""
+    if in_place(v, omega, offset):
+        return kept
+    enlarged = radius + margin
+    travel = dc_max
+    turning = abs(omega) > STILL
+    icr_y = rho = centre_angle = turn = forward = 0.0
+    if turning:
+        icr_y = v / omega
+        rho = math.hypot(offset, icr_y)
+        centre_angle = math.atan2(-icr_y, offset)
+        turn = 1.0 if omega > 0 else -1.0
+    else:
+        forward = np.sign(v)
+    for j in order:
+        if distance[j] - enlarged >= travel:
+            break
+        r = enlarged if distance[j] >= enlarged else radius
+        if turning:
+            qx, qy = px[j] + offset, py[j] - icr_y
+            # Far outside the band |d - rho| < r, by squares (no square root); the exact test follows.
+            d2 = qx * qx + qy * qy
+            if d2 > (rho + r) ** 2 * (1 + BAND_SLACK) or (rho > r and d2 < (rho - r) ** 2 * (1 - BAND_SLACK)):
+                continue
+            d = math.hypot(qx, qy)
+            if abs(d - rho) < r:
+                ahead = np.mod(turn * (math.atan2(qy, qx) - centre_angle), 2 * np.pi)
+                cos_touch = (rho ** 2 + d ** 2 - r * r) / max(2 * rho * d, 1e-12)
+                touch = math.acos(min(max(cos_touch, -1.0), 1.0))
+                travel = min(travel, rho * max(ahead - touch, 0.0))
+        else:
+            ahead = forward * px[j]
+            if ahead > 0 and abs(py[j]) < r:
+                travel = min(travel, ahead - math.sqrt(max(r * r - py[j] * py[j], 0.0)))
+    return travel
+
+
 @njit("f8[::1](f8[::1], f8[::1], f8[::1], f8[::1], f8, f8, f8, f8)", cache=True)
 def collision_distances(v, omega, px, py, radius, margin, offset, dc_max):  # noqa: PLR0913
     """DC_cd per candidate (v[k], omega[k]) for points (px, py) in the robot frame, centre at the origin."""
-    enlarged = radius + margin
-    n = v.shape[0]
-    distance = np.hypot(px, py)
-    kept = min(max(distance.min() - enlarged, 0.0), dc_max) if px.shape[0] else dc_max
-    # The points outside the robot's circle, nearest first: a point at distance d cannot be touched before the
-    # centre has travelled d - r, so the search along a candidate ends at the first point beyond its best.
-    order = np.argsort(distance)
-    order = order[distance[order] >= radius]
-    out = np.empty(n)
-    for k in range(n):
-        if in_place(v[k], omega[k], offset):
-            out[k] = kept
-            continue
-        travel = dc_max
-        turning = abs(omega[k]) > STILL
-        if turning:
-            icr_y = v[k] / omega[k]
-            rho = math.hypot(offset, icr_y)
-            centre_angle = math.atan2(-icr_y, offset)
-            turn = 1.0 if omega[k] > 0 else -1.0
-        else:
-            forward = np.sign(v[k])
-        for j in order:
-            if distance[j] - enlarged >= travel:
-                break
-            r = enlarged if distance[j] >= enlarged else radius
-            if turning:
-                qx, qy = px[j] + offset, py[j] - icr_y
-                # Far outside the band |d - rho| < r, by squares (no square root); the exact test follows.
-                d2 = qx * qx + qy * qy
-                if d2 > (rho + r) ** 2 * (1 + BAND_SLACK) or (rho > r and d2 < (rho - r) ** 2 * (1 - BAND_SLACK)):
-                    continue
-                d = math.hypot(qx, qy)
-                if abs(d - rho) < r:
-                    ahead = np.mod(turn * (math.atan2(qy, qx) - centre_angle), 2 * np.pi)
-                    cos_touch = (rho ** 2 + d ** 2 - r * r) / max(2 * rho * d, 1e-12)
-                    touch = math.acos(min(max(cos_touch, -1.0), 1.0))
-                    travel = min(travel, rho * max(ahead - touch, 0.0))
-            else:
-                ahead = forward * px[j]
-                if ahead > 0 and abs(py[j]) < r:
-                    travel = min(travel, ahead - math.sqrt(max(r * r - py[j] * py[j], 0.0)))
-        out[k] = travel
+    distance, order, kept = _points_outside(px, py, radius, margin, dc_max)
+    out = np.empty(v.shape[0])
+    for k in range(v.shape[0]):
+        out[k] = _collision_distance(v[k], omega[k], px, py, distance, order, radius, margin, offset, dc_max, kept)
     return out
 
 
-@njit("b1[::1](f8[::1], f8[::1], f8[::1], f8[::1], f8, f8, f8, f8, f8, f8, f8)", cache=True)
-def stops_clear(v, omega, all_x, all_y, radius, margin, reach, offset, dt, brake, turn):  # noqa: PLR0913
-    """ST_v per candidate: the centre's path, one cycle at (v, omega) then braking at ``brake`` two cycles a step
-    (the turn rate following the curvature, changing at most ``turn`` a step), clear of the points outside the
-    robot's circle and nearer than ``reach``: by the circle enlarged by ``margin``, or by the robot's own circle
-    for a point between the two."""
-    n = v.shape[0]
+@njit(cache=True)
+def _stop_points(v, all_x, all_y, radius, margin, reach, dt, brake):  # noqa: PLR0913
+    """The points a stop can reach (outside the robot's circle, nearer than ``reach``) with each one's squared
+    clearance threshold, and the steps of the held cycle and the braking until the fastest candidate has stopped."""
     enlarged = radius + margin
-    px, py, radii = np.empty(all_x.shape[0]), np.empty(all_x.shape[0]), np.empty(all_x.shape[0])
+    px, py, threshold = np.empty(all_x.shape[0]), np.empty(all_x.shape[0]), np.empty(all_x.shape[0])
     m = 0
     for j in range(all_x.shape[0]):
         distance = math.hypot(all_x[j], all_y[j])
         if radius <= distance < reach:
             px[m], py[m] = all_x[j], all_y[j]
-            radii[m] = enlarged if distance >= enlarged else radius
+            r = enlarged if distance >= enlarged else radius
+            threshold[m] = (px[m] ** 2 + py[m] ** 2 - r ** 2) / 2
             m += 1
-    clear = np.ones(n, np.bool_)
-    if m == 0:
-        return clear
     top = 0.0
-    for k in range(n):
+    for k in range(v.shape[0]):
         top = max(top, abs(v[k]))
     steps = 1  # the held cycle; then braking until the fastest candidate has stopped
     speed = top
@@ -106,38 +116,80 @@ def stops_clear(v, omega, all_x, all_y, radius, margin, reach, offset, dt, brake
         steps += 1
         if speed == 0.0:
             break
-    threshold = np.empty(m)
-    for j in range(m):
-        threshold[j] = (px[j] ** 2 + py[j] ** 2 - radii[j] ** 2) / 2
-    for k in range(n):
-        speed_now, w_now = abs(v[k]), omega[k]
-        moving = speed_now > STILL
-        curvature = omega[k] / v[k] if moving else 0.0
-        direction = np.sign(v[k])
-        th = x = y = 0.0
-        for s in range(steps):
-            if s == 0:
-                speed_next, w_next, step_dt = speed_now, w_now, dt
-            else:
-                speed_next = max(speed_now - brake * 2 * dt, 0.0)
-                w_next = min(max(curvature * direction * speed_next, w_now - turn), w_now + turn)
-                step_dt = 2 * dt
-            step = direction * (speed_now + speed_next) / 2 * step_dt
-            mean_w = (w_now + w_next) / 2
-            mid = th + mean_w * step_dt / 2
-            th += mean_w * step_dt
-            x += step * math.cos(mid)
-            y += step * math.sin(mid)
-            cx, cy = x + offset * (math.cos(th) - 1.0), y + offset * math.sin(th)
-            half_c2 = (cx ** 2 + cy ** 2) / 2
-            for j in range(m):
-                if cx * px[j] + cy * py[j] - half_c2 > threshold[j]:
-                    clear[k] = False
-                    break
-            if not clear[k]:
-                break
-            speed_now, w_now = speed_next, w_next
+    return px[:m], py[:m], threshold[:m], steps
+
+
+@njit(cache=True)
+def _stop_clear(v, omega, px, py, threshold, steps, offset, dt, brake, turn):  # noqa: PLR0913
+    """ST_v of one candidate (v, omega) against ``_stop_points``'s points."""
+    speed_now, w_now = abs(v), omega
+    curvature = omega / v if speed_now > STILL else 0.0
+    direction = np.sign(v)
+    th = x = y = 0.0
+    for s in range(steps):
+        if s == 0:
+            speed_next, w_next, step_dt = speed_now, w_now, dt
+        else:
+            speed_next = max(speed_now - brake * 2 * dt, 0.0)
+            w_next = min(max(curvature * direction * speed_next, w_now - turn), w_now + turn)
+            step_dt = 2 * dt
+        step = direction * (speed_now + speed_next) / 2 * step_dt
+        mean_w = (w_now + w_next) / 2
+        mid = th + mean_w * step_dt / 2
+        th += mean_w * step_dt
+        x += step * math.cos(mid)
+        y += step * math.sin(mid)
+        cx, cy = x + offset * (math.cos(th) - 1.0), y + offset * math.sin(th)
+        half_c2 = (cx ** 2 + cy ** 2) / 2
+        for j in range(px.shape[0]):
+            if cx * px[j] + cy * py[j] - half_c2 > threshold[j]:
+                return False
+        speed_now, w_now = speed_next, w_next
+    return True
+
+
+@njit("b1[::1](f8[::1], f8[::1], f8[::1], f8[::1], f8, f8, f8, f8, f8, f8, f8)", cache=True)
+def stops_clear(v, omega, all_x, all_y, radius, margin, reach, offset, dt, brake, turn):  # noqa: PLR0913
+    """ST_v per candidate: the centre's path, one cycle at (v, omega) then braking at ``brake`` two cycles a step
+    (the turn rate following the curvature, changing at most ``turn`` a step), clear of the points outside the
+    robot's circle and nearer than ``reach``: by the circle enlarged by ``margin``, or by the robot's own circle
+    for a point between the two."""
+    px, py, threshold, steps = _stop_points(v, all_x, all_y, radius, margin, reach, dt, brake)
+    clear = np.ones(v.shape[0], np.bool_)
+    if px.shape[0] == 0:
+        return clear
+    for k in range(v.shape[0]):
+        clear[k] = _stop_clear(v[k], omega[k], px, py, threshold, steps, offset, dt, brake, turn)
     return clear
+
+
+@njit("Tuple((i8, f8))(f8[::1], f8[::1], f8[::1], b1[::1], f8[::1], f8[::1], f8[::1], f8, f8, f8, f8, f8, f8, f8, "
+      "f8, f8, f8)", cache=True)
+def best_primary(v, omega, base, admissible, dc_scale, all_x, all_y, radius, margin, reach, offset, dt,  # noqa
+                 brake, turn, dc_max, dc_min, near_scale):
+    """The argmax of the modified window's primary objective (3.35) (FRC; RFRC with ``near_scale`` 1) and its
+    value, or (-1, 0) when no candidate is admissible and stops clear. Candidates are taken best ``base`` first,
+    and DC_cd and ST_v found only for those that could still win: the same choice as scoring every candidate
+    (np.argmax's, the lowest index among equals), at a few candidates' cost. ``dc_scale``: the factor on each
+    candidate's DC_cd (the tricycle's DCF)."""
+    distance, order, kept = _points_outside(all_x, all_y, radius, margin, dc_max)
+    px, py, threshold, steps = _stop_points(v, all_x, all_y, radius, margin, reach, dt, brake)
+    best, best_score = -1, 0.0
+    for k in np.argsort(-base, kind="mergesort"):  # stable: equal bases in index order
+        bound = max(base[k], near_scale * base[k])
+        if best >= 0 and bound < best_score:
+            break
+        if not admissible[k]:
+            continue
+        dc = _collision_distance(v[k], omega[k], all_x, all_y, distance, order, radius, margin, offset, dc_max,
+                                 kept) * dc_scale[k]
+        if not (in_place(v[k], omega[k], offset)
+                or (dc > 0 and _stop_clear(v[k], omega[k], px, py, threshold, steps, offset, dt, brake, turn))):
+            continue
+        score = base[k] if dc > dc_min else near_scale * base[k]
+        if best < 0 or score > best_score or (score == best_score and k < best):
+            best, best_score = k, score
+    return best, best_score
 
 
 @njit("f8[:, ::1](f8[:, ::1], f8, f8, f8, f8, f8, f8)", cache=True)

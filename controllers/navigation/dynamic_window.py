@@ -371,17 +371,37 @@ class DynamicWindow:
         curvature (omega following c v as fast as the drive's angular acceleration allows), the circle enlarged
         by ``margin`` stays clear of every obstacle point outside it, and the robot's own circle of every point
         between the two (as in ``collision_distances``)."""
-        p, lim = self.params, self.limits
         if v.size == 0:
             return np.ones(0, bool)
-        brake = min(p.a_a, lim.accel_max)
+        x, y = _columns(points)
+        return kernels.stops_clear(_floats(v), _floats(omega), x, y, self.radius, margin, *self._stopping(v, margin))
+
+    def _stopping(self, v: np.ndarray, margin: float) -> tuple[float, float, float, float, float]:
+        """``stops_clear``'s model of a stop: the reach of the points it can meet, the offset, the cycle, the
+        braking deceleration and the turn-rate change per braking step."""
+        brake = min(self.params.a_a, self.limits.accel_max)
         # Only points the enlarged circle can reach: the centre moves at most the reference point's stopping
         # path plus twice the offset (the centre swung round to the reference point's other side).
         fastest = float(np.abs(v).max())
         reach = self.radius + margin + fastest * self.dt + fastest ** 2 / (2 * brake) + 0.1 + 2 * abs(self.offset)
+        return reach, self.offset, self.dt, brake, self.limits.angular_accel_max * 2 * self.dt
+
+    def best_primary(self, v: np.ndarray, omega: np.ndarray, base: np.ndarray, admissible: np.ndarray,
+                     steers_to_close: np.ndarray, points: np.ndarray, margin: float) -> tuple[int, float]:
+        """The modified window's choice by its primary objective, (3.35) for FRC and (3.39) for RFRC: the index of
+        the best admissible candidate whose stop is clear (ST_v), and its value; (-1, 0) if there is none. FRC
+        scales a candidate's value by alpha_3 once its DC_cd (times DCF for a tricycle steering towards a close
+        side obstacle) is at most DC_cdmin. ``dwa_kernels.best_primary`` measures DC_cd and ST_v only for the
+        candidates that could still win: the same choice as scoring them all (docs/decisions.md, "Navigation
+        decisions compiled")."""
+        p = self.params
+        frc = self.method is Method.FRC
+        dc_scale = np.where(steers_to_close, p.dcf, 1.0) if frc and self.tricycle else np.ones(v.size)
         x, y = _columns(points)
-        return kernels.stops_clear(_floats(v), _floats(omega), x, y, self.radius, margin, reach, self.offset, self.dt,
-                                   brake, lim.angular_accel_max * 2 * self.dt)
+        best, score = kernels.best_primary(_floats(v), _floats(omega), _floats(base), admissible, dc_scale, x, y,
+                                           self.radius, margin, *self._stopping(v, margin), p.dc_max, p.dc_min,
+                                           p.alpha3 if frc else 1.0)
+        return int(best), float(score)
 
     def towards(self, v: np.ndarray, omega: np.ndarray, points: np.ndarray) -> np.ndarray:
         """For each candidate, whether the centre moves towards any of ``points``: one of them lies ahead along the
@@ -433,10 +453,20 @@ class DynamicWindow:
         safe = ~self.towards(v, omega, flagged)
 
         curvature_ok, steers_to_close = self._curvature_checks(state, v, omega, points, distance)
+        admissible = safe & curvature_ok
+        # The heading turned by the time a turn at omega_cd has been stopped at the drive's angular limit.
+        turned = omega * self.dt + omega * np.abs(omega) / (2 * lim.angular_accel_max)
+        heading_term = 1.0 - np.abs(wrap(heading - turned)) / np.pi
+        speed_term = np.abs(v) / v_max if v_max > 0 else np.zeros_like(v)
+        base = p.alpha2 * heading_term + p.gamma * speed_term
+        if self.method.modified:  # (3.35), (3.39)
+            best, score = self.best_primary(v, omega, base, admissible, steers_to_close, points, margin)
+            if best >= 0:
+                return Decision(float(v[best]), float(omega[best]), "primary", score, v_min)
+
         dc = self.collision_distances(v, omega, points, margin)
         if self.tricycle and self.method is Method.FRC:
             dc = np.where(steers_to_close, dc * p.dcf, dc)
-
         # (3.33) by integration [RECON]. A candidate that leaves the centre where it is (a stop; a differential
         # drive's point turn) sweeps nothing new: it can always stop, even with an obstacle inside the margin.
         # Its DC_cd (the clearance it keeps) still sets the alpha_3 scaling of (3.35).
@@ -446,25 +476,12 @@ class DynamicWindow:
             st_w = np.ones(v.size, bool)  # §3.5: tricycles check ST_v only
         else:
             st_w = can_stop_turning(dc, omega, alpha_min)  # (3.34)
-
-        # The heading turned by the time a turn at omega_cd has been stopped at the drive's angular limit.
-        turned = omega * self.dt + omega * np.abs(omega) / (2 * lim.angular_accel_max)
-        heading_term = 1.0 - np.abs(wrap(heading - turned)) / np.pi
-        speed_term = np.abs(v) / v_max if v_max > 0 else np.zeros_like(v)
-        base = p.alpha2 * heading_term + p.gamma * speed_term
-        admissible = safe & curvature_ok
-        if self.method is Method.FRC:  # (3.35)
-            primary = np.where(st_v, np.where(dc > p.dc_min, base, p.alpha3 * base), INVALID)
-        elif self.method is Method.RFRC:  # (3.39)
-            primary = np.where(st_v, base, INVALID)
-        else:  # (3.38)
+        if not self.method.modified:  # (3.38)
             beta1 = p.beta1_odw if self.method is Method.ODW else p.beta1_odwds
-            primary = np.where(st_v & st_w, base + beta1 * dc / p.dc_max, INVALID)
-        primary = np.where(admissible, primary, INVALID)
-        best = int(np.argmax(primary))
-        if primary[best] > INVALID:
-            return Decision(float(v[best]), float(omega[best]), "primary", float(primary[best]), v_min)
-        if not self.method.modified:
+            primary = np.where(admissible & st_v & st_w, base + beta1 * dc / p.dc_max, INVALID)
+            best = int(np.argmax(primary))
+            if primary[best] > INVALID:
+                return Decision(float(v[best]), float(omega[best]), "primary", float(primary[best]), v_min)
             return self._brake(state, v_window, (w_lo, w_hi), v_min)
 
         if self.tricycle and state.v == 0.0:
@@ -582,7 +599,11 @@ def _columns(points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 def _samples(lo: float, hi: float, count: int) -> np.ndarray:
     """``count`` evenly spaced values over [lo, hi], plus 0 when it lies inside."""
-    values = np.linspace(lo, hi, count) if hi > lo else np.array([lo])
+    if hi > lo and count > 1:  # np.linspace's arithmetic, without its generality's cost
+        values = np.arange(count, dtype=float) * ((hi - lo) / (count - 1)) + lo
+        values[-1] = hi
+    else:
+        values = np.array([lo])
     if lo < 0.0 < hi:
         values = np.unique(np.append(values, 0.0))
     return values
@@ -646,7 +667,9 @@ def _to_frame(pose: tuple[float, float, float], points: np.ndarray) -> np.ndarra
     """Points (m, 2) given in the frame of ``pose`` (x, y, heading), in the pose's parent frame."""
     c, s = math.cos(pose[2]), math.sin(pose[2])
     x, y = points[:, 0], points[:, 1]
-    return np.column_stack([pose[0] + c * x - s * y, pose[1] + s * x + c * y])
+    out = np.empty((len(points), 2))
+    out[:, 0], out[:, 1] = pose[0] + c * x - s * y, pose[1] + s * x + c * y
+    return out
 
 
 class DynamicWindowController:
@@ -743,7 +766,8 @@ class DynamicWindowController:
         bearings = np.asarray(obs.ir_bearings, float)
         seen = np.isfinite(ranges)
         reach = np.broadcast_to(self.sensor_radius, ranges.shape)[seen] + ranges[seen]
-        body = np.column_stack([self.offset + reach * np.cos(bearings[seen]), reach * np.sin(bearings[seen])])
+        body = np.empty((len(reach), 2))
+        body[:, 0], body[:, 1] = self.offset + reach * np.cos(bearings[seen]), reach * np.sin(bearings[seen])
         return np.concatenate([body, contact]) if len(contact) else body
 
     def _remember(self, time: float, body: np.ndarray) -> np.ndarray:

@@ -4,12 +4,13 @@ compiled re-planning test against the numpy form it replaced."""
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 import numpy as np
 import pytest
 
 from teamsim.controllers.navigation import dwa_kernels as kernels
-from teamsim.controllers.navigation.dynamic_window import DynamicWindow
+from teamsim.controllers.navigation.dynamic_window import INVALID, DynamicWindow, DynamicWindowParams, Method
 from teamsim.controllers.navigation.occupancy_grid import OccupancyGrid
 from teamsim.controllers.navigation.reference_dwa import _braking_steps, _collision_distance, _stops_clear
 from teamsim.models.robot import DriveLimits
@@ -61,6 +62,39 @@ def test_stops_clear_matches_the_reference(form):
         blocked += expected.count(False)
     assert 0.1 * checked < blocked < 0.9 * checked  # the scenes test both outcomes
 
+
+@pytest.mark.parametrize("form", WINDOWS)
+@pytest.mark.parametrize("method", [Method.FRC, Method.RFRC])
+def test_best_primary_is_the_argmax_of_every_candidate_scored(form, method):
+    """The lazy search (DC_cd and ST_v only for candidates that could still win) against scoring them all as
+    (3.35) / (3.39) print it, ties included (equal bases: the lowest index wins, as np.argmax)."""
+    kind, radius, offset = {"differential": ("diffdrive", 0.35, 0.0), "tricycle": ("tricycle", 0.5, 0.25)}[form]
+    window = DynamicWindow(LIMITS, kind, radius, method=method, centre_offset=offset,
+                           params=replace(DynamicWindowParams(), dcf=0.5))
+    p, rng = window.params, np.random.default_rng(13)
+    found = scaled = 0
+    for _ in range(200):
+        v, omega, points, margin = scene(rng)
+        base = np.round(rng.uniform(0.0, 0.6, v.size), 1)  # few distinct values: many ties
+        share = rng.choice([0.8, 0.05])  # at times only a few, none of them standing: maybe none stops clear
+        admissible = rng.random(v.size) < share
+        admissible[:5] &= share > 0.5
+        steers = rng.random(v.size) < 0.3
+        dc = window.collision_distances(v, omega, points, margin)
+        if method is Method.FRC and window.tricycle:
+            dc = np.where(steers, dc * p.dcf, dc)
+        st_v = window.in_place(v, omega) | ((dc > 0) & window.stops_clear(v, omega, points, margin))
+        value = np.where(dc > p.dc_min, base, p.alpha3 * base) if method is Method.FRC else base
+        primary = np.where(admissible & st_v, value, INVALID)
+        expected = int(np.argmax(primary)) if primary.max() > INVALID else -1
+        best, score = window.best_primary(v, omega, base, admissible, steers, points, margin)
+        assert best == expected
+        if best >= 0:
+            assert score == primary[best]
+            found += 1
+            scaled += bool(dc[best] <= p.dc_min)
+    assert 20 < found < 200  # both outcomes
+    assert method is Method.RFRC or scaled > 0  # and FRC's alpha_3 scaling chosen at times
 
 def test_memory_thinning_keeps_the_first_point_of_every_cell_as_np_unique_does():
     rng, kept, seen = np.random.default_rng(13), 0, 0
