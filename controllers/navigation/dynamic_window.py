@@ -698,7 +698,8 @@ class DynamicWindowController:
         self.sensor_radius = np.asarray(footprint_radius if sensor_radius is None else sensor_radius, float)
         self.memory_seconds = obstacle_memory
         self.tracker = _PoseTracker(history_seconds=max(obstacle_memory, 2.0))
-        self.memory: deque = deque()  # (time, obstacle points (m, 2) in the odometry frame)
+        self.memory: deque = deque()  # (time, how many points) of each reading remembered, oldest first
+        self.remembered = np.empty((0, 2))  # their obstacle points in the odometry frame, in the same order
         self.state = DriveState()
         self.v_min = 0.0
         self.last_decision: Decision | None = None
@@ -774,12 +775,14 @@ class DynamicWindowController:
         """Points ``body`` (robot frame) added to the memory; all remembered points relative to the centre, in
         the robot frame."""
         ox, oy, oth = self.tracker.odometry
-        self.memory.append((time, _to_frame((ox, oy, oth), body)))
+        self.memory.append((time, len(body)))
+        forgotten = 0
         while self.memory[0][0] < time - self.memory_seconds:
-            self.memory.popleft()
+            forgotten += self.memory.popleft()[1]
+        world = np.concatenate([self.remembered[forgotten:], _to_frame((ox, oy, oth), body)])
+        self.remembered = world
         c, s = math.cos(oth), math.sin(oth)
         # A slow robot sees the same spots again and again: keep one point per 2 cm cell.
-        world = np.ascontiguousarray(np.concatenate([pts for _, pts in self.memory]), dtype=float)
         return kernels.thin_to_robot_frame(world, MEMORY_CELL, ox, oy, c, s, self.offset)
 
     def _command(self, v: float, omega: float, behaviour: str) -> Command:
