@@ -4,9 +4,9 @@
   before the robot's circle touches a point, capped at DC_cdmax;
 - :func:`stops_clear`: ST_v (3.33) by integration, whether the robot, holding a candidate one cycle and then
   braking along its curvature, keeps its circle clear of every point;
-- :func:`best_primary`: the choice by FRC's primary objective (3.35) (RFRC's (3.39)), measuring DC_cd and ST_v
-  only for the candidates that could still win (docs/decisions.md, "The primary objective without measuring
-  every candidate");
+- :func:`best_primary`: the choice by a primary objective ((3.35) FRC, (3.38) ODW and ODWDS, (3.39) RFRC),
+  measuring DC_cd and ST_v only for the candidates that could still win (docs/decisions.md, "The primary
+  objective without measuring every candidate");
 - :func:`thin_to_robot_frame`: the obstacle memory, one point per 2 cm square, in the robot frame.
 - :func:`path_blocked`: HRDU's re-planning trigger, an impassable cell near the path ahead.
 
@@ -164,19 +164,22 @@ def stops_clear(v, omega, all_x, all_y, radius, margin, reach, offset, dt, brake
 
 
 @njit("Tuple((i8, f8))(f8[::1], f8[::1], f8[::1], b1[::1], f8[::1], f8[::1], f8[::1], f8, f8, f8, f8, f8, f8, f8, "
-      "f8, f8, f8)", cache=True)
+      "f8, f8, f8, f8, b1, f8)", cache=True)
 def best_primary(v, omega, base, admissible, dc_scale, all_x, all_y, radius, margin, reach, offset, dt,  # noqa
-                 brake, turn, dc_max, dc_min, near_scale):
-    """The argmax of the modified window's primary objective (3.35) (FRC; RFRC with ``near_scale`` 1) and its
-    value, or (-1, 0) when no candidate is admissible and stops clear. Candidates are taken best ``base`` first,
-    and DC_cd and ST_v found only for those that could still win: the same choice as scoring every candidate
-    (np.argmax's, the lowest index among equals), at a few candidates' cost. ``dc_scale``: the factor on each
-    candidate's DC_cd (the tricycle's DCF)."""
+                 brake, turn, dc_max, dc_min, near_scale, clearance_weight, turn_stop, alpha_min):
+    """The argmax of a primary objective and its value, or (-1, 0) when no admissible candidate qualifies:
+    ``base`` (``near_scale`` times ``base`` once DC_cd <= DC_cdmin) plus ``clearance_weight`` DC_cd / DC_cdmax,
+    for candidates whose stop is clear (ST_v) and, with ``turn_stop``, whose turn can be stopped at ``alpha_min``
+    (ST_omega, (3.34); with alpha_min 0, as numpy's division by zero gives, none can). Candidates are taken best
+    ``base`` first, and DC_cd and ST_v found only for those that could still win: the same choice as scoring
+    every candidate (np.argmax's, the lowest index among equals), at a few candidates' cost. ``dc_scale``: the
+    factor on each candidate's DC_cd (the tricycle's DCF)."""
     distance, order, kept = _points_outside(all_x, all_y, radius, margin, dc_max)
     px, py, threshold, steps = _stop_points(v, all_x, all_y, radius, margin, reach, dt, brake)
+    bonus = clearance_weight * dc_scale.max()  # the most the clearance term can add
     best, best_score = -1, 0.0
     for k in np.argsort(-base, kind="mergesort"):  # stable: equal bases in index order
-        bound = max(base[k], near_scale * base[k])
+        bound = max(base[k], near_scale * base[k]) + bonus
         if best >= 0 and bound < best_score:
             break
         if not admissible[k]:
@@ -186,7 +189,9 @@ def best_primary(v, omega, base, admissible, dc_scale, all_x, all_y, radius, mar
         if not (in_place(v[k], omega[k], offset)
                 or (dc > 0 and _stop_clear(v[k], omega[k], px, py, threshold, steps, offset, dt, brake, turn))):
             continue
-        score = base[k] if dc > dc_min else near_scale * base[k]
+        if turn_stop and not (dc > 0 and alpha_min > 0 and dc > omega[k] ** 2 / (2 * alpha_min)):
+            continue
+        score = (base[k] if dc > dc_min else near_scale * base[k]) + clearance_weight * dc / dc_max
         if best < 0 or score > best_score or (score == best_score and k < best):
             best, best_score = k, score
     return best, best_score

@@ -387,20 +387,25 @@ class DynamicWindow:
         return reach, self.offset, self.dt, brake, self.limits.angular_accel_max * 2 * self.dt
 
     def best_primary(self, v: np.ndarray, omega: np.ndarray, base: np.ndarray, admissible: np.ndarray,
-                     steers_to_close: np.ndarray, points: np.ndarray, margin: float) -> tuple[int, float]:
-        """The modified window's choice by its primary objective, (3.35) for FRC and (3.39) for RFRC: the index of
-        the best admissible candidate whose stop is clear (ST_v), and its value; (-1, 0) if there is none. FRC
-        scales a candidate's value by alpha_3 once its DC_cd (times DCF for a tricycle steering towards a close
-        side obstacle) is at most DC_cdmin. ``dwa_kernels.best_primary`` measures DC_cd and ST_v only for the
-        candidates that could still win: the same choice as scoring them all (docs/decisions.md, "Navigation
-        decisions compiled")."""
-        p = self.params
-        frc = self.method is Method.FRC
+                     steers_to_close: np.ndarray, points: np.ndarray, margin: float,
+                     alpha_min: float) -> tuple[int, float]:
+        """The choice by the primary objective: the index of the best admissible candidate whose stop is clear
+        (ST_v), and its value; (-1, 0) if there is none. FRC (3.35) scores ``base``, times alpha_3 once DC_cd
+        (times DCF for a tricycle steering towards a close side obstacle) is at most DC_cdmin; RFRC (3.39)
+        ``base``; ODW and ODWDS (3.38) ``base`` + beta_1 DC_cd / DC_cdmax, a differential drive's candidates only
+        where ST_omega (3.34) holds too. ``dwa_kernels.best_primary`` measures DC_cd and ST_v only for the
+        candidates that could still win: the same choice as scoring them all (docs/decisions.md, "The primary
+        objective without measuring every candidate")."""
+        p, method = self.params, self.method
+        frc = method is Method.FRC
         dc_scale = np.where(steers_to_close, p.dcf, 1.0) if frc and self.tricycle else np.ones(v.size)
+        near_scale = p.alpha3 if frc else 1.0
+        clearance_weight = {Method.ODW: p.beta1_odw, Method.ODWDS: p.beta1_odwds}.get(method, 0.0)
+        turn_stop = not (method.modified or self.tricycle)  # §3.5: tricycles check ST_v only
         x, y = _columns(points)
         best, score = kernels.best_primary(_floats(v), _floats(omega), _floats(base), admissible, dc_scale, x, y,
                                            self.radius, margin, *self._stopping(v, margin), p.dc_max, p.dc_min,
-                                           p.alpha3 if frc else 1.0)
+                                           near_scale, clearance_weight, turn_stop, alpha_min)
         return int(best), float(score)
 
     def towards(self, v: np.ndarray, omega: np.ndarray, points: np.ndarray) -> np.ndarray:
@@ -459,10 +464,11 @@ class DynamicWindow:
         heading_term = 1.0 - np.abs(wrap(heading - turned)) / np.pi
         speed_term = np.abs(v) / v_max if v_max > 0 else np.zeros_like(v)
         base = p.alpha2 * heading_term + p.gamma * speed_term
-        if self.method.modified:  # (3.35), (3.39)
-            best, score = self.best_primary(v, omega, base, admissible, steers_to_close, points, margin)
-            if best >= 0:
-                return Decision(float(v[best]), float(omega[best]), "primary", score, v_min)
+        best, score = self.best_primary(v, omega, base, admissible, steers_to_close, points, margin, alpha_min)
+        if best >= 0:  # (3.35), (3.38), (3.39)
+            return Decision(float(v[best]), float(omega[best]), "primary", score, v_min)
+        if not self.method.modified:
+            return self._brake(state, v_window, (w_lo, w_hi), v_min)
 
         dc = self.collision_distances(v, omega, points, margin)
         if self.tricycle and self.method is Method.FRC:
@@ -476,13 +482,6 @@ class DynamicWindow:
             st_w = np.ones(v.size, bool)  # §3.5: tricycles check ST_v only
         else:
             st_w = can_stop_turning(dc, omega, alpha_min)  # (3.34)
-        if not self.method.modified:  # (3.38)
-            beta1 = p.beta1_odw if self.method is Method.ODW else p.beta1_odwds
-            primary = np.where(admissible & st_v & st_w, base + beta1 * dc / p.dc_max, INVALID)
-            best = int(np.argmax(primary))
-            if primary[best] > INVALID:
-                return Decision(float(v[best]), float(omega[best]), "primary", float(primary[best]), v_min)
-            return self._brake(state, v_window, (w_lo, w_hi), v_min)
 
         if self.tricycle and state.v == 0.0:
             steer = self._steer_at_rest(state, points, distance, heading, v_min)

@@ -177,18 +177,21 @@ def test_eq_3_34_needs_a_positive_collision_distance():
 
 
 def test_eq_3_34_gates_the_original_window_of_a_differential_drive(monkeypatch):
-    """(3.34) in (3.38): the original window needs ST_v and ST_omega; alpha_min from the angular window."""
-    seen = []
+    """(3.34) in (3.38): the original window needs ST_v and ST_omega; alpha_min from the angular window. The
+    objective is scored in ``dwa_kernels.best_primary``: it is asked for ST_omega at this alpha_min, and with an
+    alpha_min of 0 (no turn can be stopped) no candidate qualifies."""
+    kernel, seen = dynamic_window.kernels.best_primary, []
 
-    def never(dc, omega, alpha_min):
-        seen.append(alpha_min)
-        return np.zeros(dc.shape, bool)
+    def no_turn_stops(*args):
+        *rest, turn_stop, alpha_min = args
+        seen.append((turn_stop, alpha_min))
+        return kernel(*rest, turn_stop, 0.0)
 
     # Without the patch this scene's decision is "primary" (test_dynamic_window.py, (3.38) by hand).
-    monkeypatch.setattr(dynamic_window, "can_stop_turning", never)
+    monkeypatch.setattr(dynamic_window.kernels, "best_primary", no_turn_stops)
     decision = differential(Method.ODW).decide(DriveState(0.3, 0.0), NO_POINTS, heading=0.0, d_tgt=9.0)
     # alpha_min = min(|omega_max - omega_c|, |omega_min - omega_c|) / dt = (0.15 * 0.1) / 0.1 = 0.15 rad/s^2.
-    assert seen == [approx(0.15)]
+    assert seen == [(True, approx(0.15))]
     assert decision.branch == "brake"
 
 

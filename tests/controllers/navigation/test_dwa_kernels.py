@@ -10,7 +10,8 @@ import numpy as np
 import pytest
 
 from teamsim.controllers.navigation import dwa_kernels as kernels
-from teamsim.controllers.navigation.dynamic_window import INVALID, DynamicWindow, DynamicWindowParams, Method
+from teamsim.controllers.navigation.dynamic_window import (INVALID, DynamicWindow, DynamicWindowParams, Method,
+                                                             can_stop_turning)
 from teamsim.controllers.navigation.occupancy_grid import OccupancyGrid
 from teamsim.controllers.navigation.reference_dwa import _braking_steps, _collision_distance, _stops_clear
 from teamsim.models.robot import DriveLimits
@@ -64,10 +65,10 @@ def test_stops_clear_matches_the_reference(form):
 
 
 @pytest.mark.parametrize("form", WINDOWS)
-@pytest.mark.parametrize("method", [Method.FRC, Method.RFRC])
+@pytest.mark.parametrize("method", list(Method))
 def test_best_primary_is_the_argmax_of_every_candidate_scored(form, method):
     """The lazy search (DC_cd and ST_v only for candidates that could still win) against scoring them all as
-    (3.35) / (3.39) print it, ties included (equal bases: the lowest index wins, as np.argmax)."""
+    (3.35), (3.38) and (3.39) print them, ties included (equal bases: the lowest index wins, as np.argmax)."""
     kind, radius, offset = {"differential": ("diffdrive", 0.35, 0.0), "tricycle": ("tricycle", 0.5, 0.25)}[form]
     window = DynamicWindow(LIMITS, kind, radius, method=method, centre_offset=offset,
                            params=replace(DynamicWindowParams(), dcf=0.5))
@@ -80,21 +81,30 @@ def test_best_primary_is_the_argmax_of_every_candidate_scored(form, method):
         admissible = rng.random(v.size) < share
         admissible[:5] &= share > 0.5
         steers = rng.random(v.size) < 0.3
+        alpha_min = float(rng.choice([0.0, rng.uniform(0.01, 0.5)]))  # 0: omega at a window edge
         dc = window.collision_distances(v, omega, points, margin)
         if method is Method.FRC and window.tricycle:
             dc = np.where(steers, dc * p.dcf, dc)
         st_v = window.in_place(v, omega) | ((dc > 0) & window.stops_clear(v, omega, points, margin))
-        value = np.where(dc > p.dc_min, base, p.alpha3 * base) if method is Method.FRC else base
+        if method.modified:
+            value = np.where(dc > p.dc_min, base, p.alpha3 * base) if method is Method.FRC else base
+        else:
+            beta1 = p.beta1_odw if method is Method.ODW else p.beta1_odwds
+            value = base + beta1 * dc / p.dc_max
+            if not window.tricycle:
+                with np.errstate(divide="ignore", invalid="ignore"):
+                    st_v &= can_stop_turning(dc, omega, alpha_min)
         primary = np.where(admissible & st_v, value, INVALID)
         expected = int(np.argmax(primary)) if primary.max() > INVALID else -1
-        best, score = window.best_primary(v, omega, base, admissible, steers, points, margin)
+        best, score = window.best_primary(v, omega, base, admissible, steers, points, margin, alpha_min)
         assert best == expected
         if best >= 0:
             assert score == primary[best]
             found += 1
             scaled += bool(dc[best] <= p.dc_min)
     assert 20 < found < 200  # both outcomes
-    assert method is Method.RFRC or scaled > 0  # and FRC's alpha_3 scaling chosen at times
+    assert method is not Method.FRC or scaled > 0  # and FRC's alpha_3 scaling chosen at times
+
 
 def test_memory_thinning_keeps_the_first_point_of_every_cell_as_np_unique_does():
     rng, kept, seen = np.random.default_rng(13), 0, 0
