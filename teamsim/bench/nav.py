@@ -10,12 +10,12 @@ too.
 Dynamic window: the wall time of each controller call (direction sensor, dynamic window, obstacle memory: one
 control tick of one robot) of FRC driving Chand's Robot A (tricycle) and Robot B (differential) across random
 worlds without physics (``teamsim.tasks.worlds.navigation.kinematic_run``). Target (issue 21): a mean of 0.3 ms
-and a p99 of 1 ms a call. The inputs of every dynamic-window decision of those runs are recorded and replayed,
-call by call in turn, through a fresh ``DynamicWindow.decide`` (numpy over all candidates, the two innermost
-loops compiled) and the plain ``reference_decide`` (``teamsim.controllers.navigation.reference_dwa``: Python
-loops over the candidates and the obstacle points), which evaluates the same window, candidates and objectives
-and must choose the same (v, omega): the ratio of their mean times is the implementation's alone. It covers the
-dynamic-window stage, not the direction sensor or obstacle memory.
+and a p99 of 1 ms a call. The observations of every call of those runs are recorded and replayed, call by call
+in turn, through two fresh FRC controllers: today's, and one whose dynamic-window decision is the plain
+``reference_decide`` (``teamsim.controllers.navigation.reference_dwa``: Python loops over every candidate and
+every obstacle point, the same window, candidates and objectives). Both must give the same command on every
+call (v, omega, behaviour and the decision's branch); the ratio of their mean call times is the decision's
+implementation's alone.
 """
 from __future__ import annotations
 
@@ -25,7 +25,7 @@ import time
 import numpy as np
 
 from teamsim.controllers.navigation.astar import PlannerParams, astar, cost_maps, reference_astar
-from teamsim.controllers.navigation.dynamic_window import FRC, DynamicWindow
+from teamsim.controllers.navigation.dynamic_window import FRC, INVALID, Decision
 from teamsim.controllers.navigation.reference_dwa import reference_decide
 from teamsim.models.robot import DriveLimits
 from teamsim.tasks.worlds.navigation import KinematicRobot, kinematic_run, random_world
@@ -68,49 +68,70 @@ def time_astar(size: int, density: float, seed: int) -> dict:
             "thesis_expanded": thesis.expanded}
 
 
-def record_decisions(controller: FRC, record: list) -> None:
-    """Make ``controller`` append the arguments of each of its dynamic-window decisions to ``record``."""
-    decide = controller.window.decide
+class RecordingController:
+    """A controller that keeps every observation it is given, in order."""
 
-    def recorded(*args, **kwargs):
-        record.append((args, kwargs))
-        return decide(*args, **kwargs)
+    def __init__(self, controller, observations: list):
+        self.controller, self.observations = controller, observations
 
-    controller.window.decide = recorded
+    def __call__(self, obs):
+        self.observations.append(obs)
+        return self.controller(obs)
+
+
+def with_reference_decide(controller: FRC) -> FRC:
+    """``controller``, its dynamic-window decision made by the plain ``reference_decide``."""
+    window = controller.window
+
+    def decide(state, points, heading, d_tgt, v_min_previous=0.0, v_cap=math.inf):
+        v, omega, branch, v_min = reference_decide(window, state, points, heading, d_tgt, v_min_previous, v_cap)
+        return Decision(v, omega, branch, INVALID, v_min)
+
+    window.decide = decide
+    return controller
 
 
 def time_decisions(density: float, worlds: int, duration: float) -> dict:
     rows = {}
     for name, robot in ROBOTS.items():
-        times, inputs = [], []
+        times, runs = [], []
         for seed in range(worlds):
             world = random_world(density, np.random.default_rng(seed))
             controller = FRC(robot.limits, robot.kind, robot.radius, world.goal, centre_offset=robot.centre_offset)
-            record_decisions(controller, inputs)
-            times.append(kinematic_run(world, controller, robot, duration).decision_times)
+            observations = []
+            times.append(kinematic_run(world, RecordingController(controller, observations), robot,
+                                       duration).decision_times)
+            runs.append((world.goal, observations))
         times = np.concatenate(times)
         rows[name] = {"calls": int(times.size), "mean_ms": 1e3 * float(times.mean()),
                       "median_ms": 1e3 * float(np.median(times)), "p99_ms": 1e3 * float(np.percentile(times, 99)),
-                      "replay": replay_decisions(robot, inputs)}
+                      "replay": replay_calls(robot, runs)}
     return rows
 
 
-def replay_decisions(robot: KinematicRobot, inputs: list) -> dict:
-    """Each recorded decision through a fresh ``DynamicWindow.decide`` and through ``reference_decide``, timed call
-    by call in turn; whether they chose the same (v, omega) (within 1e-9) and branch."""
-    window = DynamicWindow(robot.limits, robot.kind, robot.radius, centre_offset=robot.centre_offset)
+def replay_calls(robot: KinematicRobot, runs: list) -> dict:
+    """Each recorded run's observations through a fresh FRC and a fresh FRC deciding by ``reference_decide``,
+    timed call by call in turn; whether they gave the same command (v and omega within 1e-9, behaviour) from the
+    same branch."""
     frc_times, reference_times, same, branches = [], [], 0, {}
-    for args, kwargs in inputs:
-        began = time.perf_counter()
-        decision = window.decide(*args, **kwargs)
-        middle = time.perf_counter()
-        v, omega, branch, _ = reference_decide(window, *args, **kwargs)
-        reference_times.append(time.perf_counter() - middle)
-        frc_times.append(middle - began)
-        same += abs(v - decision.v) <= 1e-9 and abs(omega - decision.omega) <= 1e-9 and branch == decision.branch
-        branches[decision.branch] = branches.get(decision.branch, 0) + 1
+    for goal, observations in runs:
+        frc, reference = (FRC(robot.limits, robot.kind, robot.radius, goal, centre_offset=robot.centre_offset)
+                          for _ in range(2))
+        with_reference_decide(reference)
+        for obs in observations:
+            began = time.perf_counter()
+            command = frc(obs)
+            middle = time.perf_counter()
+            expected = reference(obs)
+            reference_times.append(time.perf_counter() - middle)
+            frc_times.append(middle - began)
+            branch = frc.last_decision.branch if frc.last_decision else None
+            same += (abs(command.v - expected.v) <= 1e-9 and abs(command.omega - expected.omega) <= 1e-9
+                     and command.behaviour == expected.behaviour
+                     and branch == (reference.last_decision.branch if reference.last_decision else None))
+            branches[branch] = branches.get(branch, 0) + 1
     frc_ms, reference_ms = 1e3 * float(np.mean(frc_times)), 1e3 * float(np.mean(reference_times))
-    return {"decisions": len(inputs), "frc_mean_ms": frc_ms, "reference_mean_ms": reference_ms,
+    return {"calls": len(frc_times), "frc_mean_ms": frc_ms, "reference_mean_ms": reference_ms,
             "ratio": reference_ms / frc_ms, "same": same, "branches": branches}
 
 
@@ -135,13 +156,13 @@ def run(grid_size: int = 1000, grid_density: float = 0.2, seed: int = 0, world_d
         verdict = "ok" if on_target else "OVER TARGET"
         print(f"  {name:<17} mean {row['mean_ms']:5.2f} ms  median {row['median_ms']:5.2f} ms  "
               f"p99 {row['p99_ms']:5.2f} ms  over {row['calls']} calls  {verdict}")
-    print("bench nav: the dynamic window's decision alone, FRC (DynamicWindow.decide) against the plain "
-          "reference_decide on the same recorded inputs")
+    print("bench nav: the whole FRC call replayed on the recorded observations, today's against one deciding by the "
+          "plain reference_decide")
     for name, row in decisions.items():
         r = row["replay"]
-        branches = ", ".join(f"{branch} {count}" for branch, count in sorted(r["branches"].items()))
+        branches = ", ".join(f"{branch} {count}" for branch, count in sorted(r["branches"].items(), key=str))
         print(f"  {name:<17} FRC mean {r['frc_mean_ms']:5.2f} ms  reference mean {r['reference_mean_ms']:5.2f} ms  "
-              f"ratio reference / FRC {r['ratio']:4.1f}x  same command {r['same']}/{r['decisions']}  "
+              f"ratio reference / FRC {r['ratio']:4.1f}x  same command {r['same']}/{r['calls']}  "
               f"({branches})")
     return {"astar": a, "decisions": decisions}
 
