@@ -285,7 +285,8 @@ class PushEnd:
         jaw still beside the box's end face, and turning along met that face. Taken for a teammate in the way, the
         end was pushed from there under the other end's name, and the next acquisition ran off past the box
         (kill:green@61.6, seed 24: the box lost at 1.99 m)."""
-        return self._turn_to_push_heading() or self._go("back_off", obs)
+        turning = self._turn_to_push_heading()
+        return turning if turning is not None else self._go("back_off", obs)
 
     def _turn_to_push_heading(self) -> Command | None:
         """A turn on the spot towards the push heading; None once it faces it."""

@@ -1,4 +1,4 @@
-"""The dynamic-window controller's innermost loops, compiled (numba): every candidate against every point.
+"""The dynamic-window controller's innermost loops, compiled (numba): candidates against obstacle points.
 
 - :func:`collision_distances`: DC_cd of §3.5, how far the centre travels along each candidate's arc (3.11)
   before the robot's circle touches a point, capped at DC_cdmax;
@@ -165,7 +165,7 @@ def stops_clear(v, omega, all_x, all_y, radius, margin, reach, offset, dt, brake
 
 @njit("Tuple((i8, f8))(f8[::1], f8[::1], f8[::1], b1[::1], f8[::1], f8[::1], f8[::1], f8, f8, f8, f8, f8, f8, f8, "
       "f8, f8, f8, f8, b1, f8)", cache=True)
-def best_primary(v, omega, base, admissible, dc_scale, all_x, all_y, radius, margin, reach, offset, dt,  # noqa
+def best_primary(v, omega, base, admissible, dc_scale, all_x, all_y, radius, margin, reach, offset, dt,  # noqa: PLR0913
                  brake, turn, dc_max, dc_min, near_scale, clearance_weight, turn_stop, alpha_min):
     """The argmax of a primary objective and its value, or (-1, 0) when no admissible candidate qualifies:
     ``base`` (``near_scale`` times ``base`` once DC_cd <= DC_cdmin) plus ``clearance_weight`` DC_cd / DC_cdmax,
@@ -173,10 +173,15 @@ def best_primary(v, omega, base, admissible, dc_scale, all_x, all_y, radius, mar
     (ST_omega, (3.34); with alpha_min 0, as numpy's division by zero gives, none can). Candidates are taken best
     ``base`` first, and DC_cd and ST_v found only for those that could still win: the same choice as scoring
     every candidate (np.argmax's, the lowest index among equals), at a few candidates' cost. ``dc_scale``: the
-    factor on each candidate's DC_cd (the tricycle's DCF)."""
+    factor on each candidate's DC_cd (the tricycle's DCF). The search may stop early because a candidate's bound
+    never rises as ``base`` falls: that needs finite ``base``, ``near_scale``, ``clearance_weight`` and
+    ``dc_scale`` >= 0, and scores above -1 (the objectives' INVALID), as every method's are."""
     distance, order, kept = _points_outside(all_x, all_y, radius, margin, dc_max)
     px, py, threshold, steps = _stop_points(v, all_x, all_y, radius, margin, reach, dt, brake)
-    bonus = clearance_weight * dc_scale.max()  # the most the clearance term can add
+    # The most the clearance term can add, in the score's own arithmetic: rounding is monotone, so no score exceeds
+    # its bound (weight * max / dc_max rounded apart from weight * (dc_max * max) / dc_max by an ulp, and a lower
+    # candidate that tied the best was skipped, issue 21 review)
+    bonus = clearance_weight * (dc_max * dc_scale.max()) / dc_max
     best, best_score = -1, 0.0
     for k in np.argsort(-base, kind="mergesort"):  # stable: equal bases in index order
         bound = max(base[k], near_scale * base[k]) + bonus

@@ -1,5 +1,6 @@
-"""A plain reference implementation of one FRC dynamic-window decision: the yardstick ``teamsim bench nav`` times
-``DynamicWindow.decide`` against, as ``reference_astar`` is the A* yardstick.
+"""A plain reference implementation of one FRC dynamic-window decision: the yardstick of ``teamsim bench nav``,
+which replays whole FRC calls through today's ``DynamicWindow.decide`` and through this, as ``reference_astar`` is
+the A* yardstick.
 
 It is deliberately unclever: Python loops over every (v, omega) candidate of the window and, inside, over every
 obstacle point, with ``math`` on floats and no numpy anywhere in the decision. It evaluates the same window, the

@@ -14,8 +14,9 @@ and a p99 of 1 ms a call. The observations of every call of those runs are recor
 in turn, through two fresh FRC controllers: today's, and one whose dynamic-window decision is the plain
 ``reference_decide`` (``teamsim.controllers.navigation.reference_dwa``: Python loops over every candidate and
 every obstacle point, the same window, candidates and objectives). Both must give the same command on every
-call (v, omega, behaviour and the decision's branch); the ratio of their mean call times is the decision's
-implementation's alone.
+call (v, omega, behaviour and the decision's branch, or the behaviour of a call that made no decision). Both
+calls include the direction sensor and the obstacle memory, so the ratio of their mean times understates the
+decision's own speed-up; their difference is the decision's alone.
 """
 from __future__ import annotations
 
@@ -109,6 +110,13 @@ def time_decisions(density: float, worlds: int, duration: float) -> dict:
     return rows
 
 
+def branch_of(controller: FRC, before: Decision | None, command) -> str:
+    """The branch of the decision ``controller`` just made, or the command's behaviour if the call made none
+    (no fix yet, arrived): its ``last_decision`` is then still the one from ``before``."""
+    decision = controller.last_decision
+    return command.behaviour if decision is None or decision is before else decision.branch
+
+
 def replay_calls(robot: KinematicRobot, runs: list) -> dict:
     """Each recorded run's observations through a fresh FRC and a fresh FRC deciding by ``reference_decide``,
     timed call by call in turn; whether they gave the same command (v and omega within 1e-9, behaviour) from the
@@ -119,16 +127,17 @@ def replay_calls(robot: KinematicRobot, runs: list) -> dict:
                           for _ in range(2))
         with_reference_decide(reference)
         for obs in observations:
+            decided = frc.last_decision, reference.last_decision
             began = time.perf_counter()
             command = frc(obs)
             middle = time.perf_counter()
             expected = reference(obs)
             reference_times.append(time.perf_counter() - middle)
             frc_times.append(middle - began)
-            branch = frc.last_decision.branch if frc.last_decision else None
+            branch = branch_of(frc, decided[0], command)
             same += (abs(command.v - expected.v) <= 1e-9 and abs(command.omega - expected.omega) <= 1e-9
                      and command.behaviour == expected.behaviour
-                     and branch == (reference.last_decision.branch if reference.last_decision else None))
+                     and branch == branch_of(reference, decided[1], expected))
             branches[branch] = branches.get(branch, 0) + 1
     frc_ms, reference_ms = 1e3 * float(np.mean(frc_times)), 1e3 * float(np.mean(reference_times))
     return {"calls": len(frc_times), "frc_mean_ms": frc_ms, "reference_mean_ms": reference_ms,
@@ -160,7 +169,7 @@ def run(grid_size: int = 1000, grid_density: float = 0.2, seed: int = 0, world_d
           "plain reference_decide")
     for name, row in decisions.items():
         r = row["replay"]
-        branches = ", ".join(f"{branch} {count}" for branch, count in sorted(r["branches"].items(), key=str))
+        branches = ", ".join(f"{branch} {count}" for branch, count in sorted(r["branches"].items()))
         print(f"  {name:<17} FRC mean {r['frc_mean_ms']:5.2f} ms  reference mean {r['reference_mean_ms']:5.2f} ms  "
               f"ratio reference / FRC {r['ratio']:4.1f}x  same command {r['same']}/{r['calls']}  "
               f"({branches})")

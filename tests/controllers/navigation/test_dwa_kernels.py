@@ -1,6 +1,7 @@
 """The dynamic window's compiled loops (dwa_kernels, through DynamicWindow's methods) against the plain Python
-loops of reference_dwa, one candidate at a time, on random scenes: the same DC_cd and the same ST_v; and HRDU's
-compiled re-planning test against the numpy form it replaced."""
+loops of reference_dwa, one candidate at a time, on random scenes: the same DC_cd and the same ST_v; the lazy
+choice by the primary objective (best_primary) against scoring every candidate; and HRDU's compiled re-planning
+test against the numpy form it replaced."""
 from __future__ import annotations
 
 import math
@@ -66,12 +67,17 @@ def test_stops_clear_matches_the_reference(form):
 
 @pytest.mark.parametrize("form", WINDOWS)
 @pytest.mark.parametrize("method", list(Method))
-def test_best_primary_is_the_argmax_of_every_candidate_scored(form, method):
+@pytest.mark.parametrize("beta1", [None, 0.1])
+def test_best_primary_is_the_argmax_of_every_candidate_scored(form, method, beta1):
     """The lazy search (DC_cd and ST_v only for candidates that could still win) against scoring them all as
-    (3.35), (3.38) and (3.39) print them, ties included (equal bases: the lowest index wins, as np.argmax)."""
+    (3.35), (3.38) and (3.39) print them, ties included (equal bases: the lowest index wins, as np.argmax). A
+    clearance weight of 0.1 with DC_cdmax 3 is one where 0.1 * 3 / 3 rounds above 0.1: a bound taken as the
+    weight itself fell an ulp short of a tying score."""
     kind, radius, offset = {"differential": ("diffdrive", 0.35, 0.0), "tricycle": ("tricycle", 0.5, 0.25)}[form]
-    window = DynamicWindow(LIMITS, kind, radius, method=method, centre_offset=offset,
-                           params=replace(DynamicWindowParams(), dcf=0.5))
+    params = replace(DynamicWindowParams(), dcf=0.5)
+    if beta1 is not None:
+        params = replace(params, beta1_odw=beta1, beta1_odwds=beta1)
+    window = DynamicWindow(LIMITS, kind, radius, method=method, centre_offset=offset, params=params)
     p, rng = window.params, np.random.default_rng(13)
     found = scaled = 0
     for _ in range(200):
@@ -104,6 +110,20 @@ def test_best_primary_is_the_argmax_of_every_candidate_scored(form, method):
             scaled += bool(dc[best] <= p.dc_min)
     assert 20 < found < 200  # both outcomes
     assert method is not Method.FRC or scaled > 0  # and FRC's alpha_3 scaling chosen at times
+
+
+def test_best_primary_keeps_a_tie_whose_clearance_term_rounds_above_its_weight():
+    """(3.38) with beta_1 = 0.1 and DC_cdmax = 3: candidate 0 backs away free (DC_cd = DC_cdmax, so its score is
+    base + 0.1 * 3 / 3, which rounds to 0.1 + 1 ulp) and candidate 1, with the higher base, drives at a point and
+    scores exactly the same. np.argmax takes candidate 0; a bound of base + beta_1 fell an ulp short of its score
+    and the search stopped before it."""
+    b0, px = 0.0123, 1.025
+    b1 = b0 + 0.1 * 3.0 / 3.0 - 0.1 * (px - 0.35) / 3.0
+    assert b1 > b0 and b0 + 0.1 < b0 + 0.1 * 3.0 / 3.0  # the scene is the one the old bound got wrong
+    best, score = kernels.best_primary(np.array([-0.2, 0.2]), np.zeros(2), np.array([b0, b1]), np.ones(2, bool),
+                                       np.ones(2), np.array([px]), np.zeros(1), 0.35, 0.0, 10.0, 0.0, 0.1, 0.1,
+                                       0.03, 3.0, 0.6, 1.0, 0.1, False, 0.0)
+    assert (best, score) == (0, b0 + 0.1 * 3.0 / 3.0)
 
 
 def test_memory_thinning_keeps_the_first_point_of_every_cell_as_np_unique_does():
