@@ -27,13 +27,18 @@ def virtual_screen():
         if os.environ.get("CI"):
             pytest.fail("Xvfb is missing on CI: .ci/run installs Debian's xvfb")
         pytest.skip("Xvfb not installed (apt-get install xvfb)")
-    display = f":{90 + os.getpid() % 400}"
-    server = subprocess.Popen(["Xvfb", display, "-screen", "0", "1024x768x24", "-nolisten", "tcp"],
-                              stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-    for _ in range(100):  # wait for its socket
-        if os.path.exists(f"/tmp/.X11-unix/X{display[1:]}"):
-            break
-        time.sleep(0.05)
+    # -displayfd: Xvfb picks a free display and writes its number once it accepts connections (a fixed number can
+    # collide with a stale server, and its socket can appear before the server is ready)
+    read_end, write_end = os.pipe()
+    server = subprocess.Popen(["Xvfb", "-displayfd", str(write_end), "-screen", "0", "1024x768x24", "-nolisten", "tcp"],
+                              stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, pass_fds=(write_end,))
+    os.close(write_end)
+    with os.fdopen(read_end) as ready:
+        number = ready.readline().strip()
+    if not number:
+        server.kill()
+        pytest.fail("Xvfb exited before it reported a display")
+    display = f":{number}"
     yield display
     server.terminate()
     server.wait(timeout=10)
@@ -51,7 +56,8 @@ def _grab(display: str) -> np.ndarray | None:
 
 def test_the_viewer_opens_steps_and_closes_on_a_virtual_screen(virtual_screen):
     env = {**os.environ, "DISPLAY": virtual_screen}
-    view = subprocess.Popen([sys.executable, "-X", "faulthandler", "-m", "teamsim.cli", "view", "wander", "--duration", "6", "--seed", "3"],
+    view = subprocess.Popen([sys.executable, "-X", "faulthandler", "-m", "teamsim.cli",
+                             "view", "wander", "--duration", "6", "--seed", "3"],
                             env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     drawn = 0.0
     while view.poll() is None:  # the window shows the arena: a good share of the screen is not background black
