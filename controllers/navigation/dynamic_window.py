@@ -113,17 +113,17 @@ from teamsim.controllers.navigation import dwa_kernels as kernels
 from teamsim.controllers.navigation.astar import PlannerParams, WeightAdaptation, adapt_weights, plan_on_grid
 from teamsim.controllers.navigation.occupancy_grid import Evidence, OccupancyGrid
 from teamsim.controllers.navigation.path_following import PathFollower, PathFollowing
+from teamsim.controllers.navigation.multi_point_turn import MultiPointTurn
 from teamsim.controllers.navigation.trap_escape import TrapEscape
 from teamsim.controllers.navigation.polar_histogram import (DirectionSensorParams, modified_target_heading,
                                                             target_heading, wrap)
-from teamsim.controllers.skills.locomotion import next_steer
+from teamsim.controllers.skills.locomotion import STEER_REQUEST, next_steer
 from teamsim.models.robot import DriveLimits
 
 # Robot kinds that drive like a tricycle or like a differential drive (skid-steer tracks do, §3.6).
 DRIVE_FORMS = {"tricycle": "tricycle", "differential": "differential", "diffdrive": "differential",
                "tracked": "differential"}
 INVALID = -1.0  # the objectives' "otherwise" value
-STEER_REQUEST = 0.01  # rad/s: the turn-only command (0, +-this) that turns a standing tricycle's wheel
 # A stall (module notes; both chosen): driven at least this fast, m/s, the odometry reads under this share of it.
 STALL_DRIVEN_SPEED = 0.05
 STALL_SPEED_SHARE = 0.25
@@ -706,7 +706,11 @@ class DynamicWindowController:
         self.arrived = False
         self.trail: list[tuple[float, float, float]] = []  # (time, x, y) of every pose estimate, for the outcome
         self.pose_estimate: tuple[float, float, float] | None = None  # the last fix advanced by odometry
-        self.escape = TrapEscape(self.goal, footprint_radius) if self.escapes_traps else None
+        self.escape = TrapEscape(self.goal, footprint_radius, multi_point=self.window.tricycle) \
+            if self.escapes_traps else None
+        # a trapped tricycle turns to face its plan in legs, having no point turns
+        self.turn = MultiPointTurn(self.window) if self.escapes_traps and self.window.tricycle else None
+        self.sweep = 0.0  # +-1 while a wedged tricycle sweeps its wheel towards that lock (``_unwedge``)
 
     @property
     def name(self) -> str:
@@ -736,12 +740,36 @@ class DynamicWindowController:
             previous = None if self.previous_direction is None else float(wrap(self.previous_direction - pose[2]))
             heading = modified_target_heading(points, heading, self.radius, self.direction, previous)
             self.previous_direction = heading + pose[2]
-        turn_first = self.escape is not None and not self.window.tricycle and self.escape.turn_first(bearing, obs.time)
+        turn_first = self.escape is not None and self.escape.turn_first(bearing, obs.time)
+        if self.turn is not None and turn_first:
+            command = self.turn.command(self.state, points, bearing)
+            if command is not None:
+                return self._command(*command, f"{self.name} escape turn")
+            self.escape.stop_turning()  # no room for a leg either way: the window drives
+        if self.turn is not None:
+            self.turn.restart()
         decision = self.window.decide(self.state, points, heading, d_tgt, self.v_min, 0.0 if turn_first else math.inf)
+        if self.turn is not None and self._wedged(decision):
+            return self._command(0.0, self.sweep * STEER_REQUEST, f"{self.name} sweep")
         self.last_decision = decision
         self.v_min = decision.v_min
         escaping = self.escape is not None and self.escape.escaping
         return self._command(decision.v, decision.omega, f"{self.name} escape" if escaping else self.name)
+
+    def _wedged(self, decision: Decision) -> bool:
+        """Whether a standing tricycle is wedged: the window has nothing to do but stand, its own steering at rest
+        done (the wheel at the lock it chose, ``_steer_at_rest``). Then the wheel sweeps from lock to lock (the
+        window's own steer requests overridden meanwhile), so that the window meets every steering angle: with
+        boxes close on both sides the lock it chose leads into one of them, and a straighter wheel leads out.
+        Ends when the window moves the robot. (Issue 22; docs/decisions.md, "Multi-point turn".)"""
+        standing = self.state.v == 0.0 and decision.v == 0.0 and decision.branch in ("steer", "curvature", "brake")
+        if not standing or (self.sweep == 0.0 and decision.branch == "steer"):
+            self.sweep = 0.0
+            return False
+        lock = self.window.steering.steer_max
+        if self.sweep == 0.0 or abs(self.state.steer - self.sweep * lock) < 1e-9:
+            self.sweep = -1.0 if self.state.steer > 0 else 1.0
+        return True
 
     def waypoint(self, pose: tuple[float, float, float], centre: tuple[float, float], obs: Observation):
         """The point the direction sensor aims at: the goal itself for the reactive controllers, or a trapped

@@ -8,7 +8,7 @@ adds the smallest piece of it that the thesis itself uses for poor progress (the
 re-planning in HRDU and §6.2):
   - every IR hit is kept, for good, as an occupied cell of a world-frame grid (``HitMap``);
   - the robot is **trapped** when ``period`` seconds have passed since its distance to the goal last fell by
-    ``progress`` (d_progmin of (3.6)) below its best;
+    ``progress`` (d_progmin of (3.6)) below its best, or when it has stood ``standstill`` seconds;
   - trapped, it plans a path to the goal with the modified A* (3.1)-(3.8) on the hits, unseen cells free,
     obstacles inflated as HRD inflates them, or by the footprint alone where that leaves no way (from the
     nearest cell outside the inflation when the robot stands beside a box), and follows it as HRD follows its
@@ -36,8 +36,11 @@ class EscapeParams:
     replan: float = 20.0  # s between plans while escaping
     facing: float = math.radians(30)  # a differential drive turns in place towards a new plan until within this
     turning: float = 15.0  # s: and for no longer (a half turn at B's limits takes about 10 s)
+    multi_point_turning: float = 60.0  # s: a tricycle's multi-point turn, for no longer (a few legs of 10-15 s)
     resolution: float = 0.1  # m, the hit grid's cell (the study's map resolution)
     margin: float = 3.0  # m of free cells planned around the hits, the robot and the goal
+    standstill: float = 10.0  # s standing that also make a trap
+    still_radius: float = 0.05  # m: the centre moving no further than this counts as standing
 
 
 class HitMap:
@@ -69,18 +72,21 @@ class TrapEscape:
     inflation beyond the footprint radius, as HRD's."""
 
     def __init__(self, goal: tuple[float, float], radius: float, params: EscapeParams = EscapeParams(),
-                 following: PathFollowing = PathFollowing()):
+                 following: PathFollowing = PathFollowing(), multi_point: bool = False):
         self.goal = goal
+        self.turn_limit = params.multi_point_turning if multi_point else params.turning
         self.radius = radius
         self.params = params
         self.following = following
         self.hits = HitMap(params.resolution)
         self.best = math.inf  # distance to the goal at the last progress
         self.best_time = 0.0
+        self.still_at, self.still_since = (math.inf, math.inf), 0.0  # where and since when the robot stands
         self.follower: PathFollower | None = None
         self.planned_at = -math.inf
         self.escapes = 0  # plans made
         self.turning = False  # turning in place towards a new plan
+        self.turn_started = -math.inf
 
     @property
     def escaping(self) -> bool:
@@ -89,13 +95,20 @@ class TrapEscape:
     def waypoint(self, time: float, centre: tuple[float, float]) -> tuple[float, float]:
         """Where to aim: the goal, or while escaping the escape path's look-ahead point."""
         distance = math.dist(centre, self.goal)
+        if math.dist(centre, self.still_at) > self.params.still_radius:
+            self.still_at, self.still_since = centre, time
         if distance <= self.best - self.params.progress or self.best == math.inf:
             self.best, self.best_time = distance, time
             self.follower = None
-        elif time - self.best_time >= self.params.period and (
-                not self.escaping or time - self.planned_at >= self.params.replan):
+        elif self._trapped(time) and (not self.escaping or time - self.planned_at >= self.params.replan):
             self._plan(time, centre)
         return self.goal if self.follower is None else self.follower.waypoint(centre, self.goal)
+
+    def _trapped(self, time: float) -> bool:
+        """No progress for ``period`` s, or no motion for ``standstill`` s (the centre within ``still_radius`` of
+        where it stood): a tricycle wedged between boxes rocks a millimetre at a time and need not wait a period."""
+        return (time - self.best_time >= self.params.period
+                or time - self.still_since >= self.params.standstill)
 
     def turn_first(self, heading: float, time: float) -> bool:
         """Whether to stop and turn in place towards the plan's way (``heading``: the bearing of its look-ahead
@@ -106,8 +119,12 @@ class TrapEscape:
         varies more across its window than the heading term) and, next to boxes, can lock into a tight circle
         that only just clears them."""
         self.turning = (self.turning and self.escaping and abs(heading) > self.params.facing
-                        and time - self.planned_at < self.params.turning)
+                        and time - self.turn_started < self.turn_limit)
         return self.turning
+
+    def stop_turning(self) -> None:
+        """End the turn towards the plan early (a multi-point turn with no room for either leg)."""
+        self.turning = False
 
     def _plan(self, time: float, centre: tuple[float, float]) -> None:
         """Plan with HRD's inflation (footprint radius plus clearance); where that leaves no way through, with the
@@ -121,7 +138,8 @@ class TrapEscape:
         self.follower = PathFollower(np.vstack([centre, path]), result.reached, grid.resolution, self.following)
         self.planned_at = time
         self.escapes += 1
-        self.turning = True
+        if not self.turning:  # a re-plan during a turn does not restart its clock
+            self.turning, self.turn_started = True, time
 
     def _free_start(self, grid: OccupancyGrid, centre: tuple[float, float], inflation: float) -> tuple[float, float]:
         """Where the plan starts: the robot's centre, or, when that lies within the planning inflation of a hit

@@ -78,6 +78,9 @@ class DifferentialDrive:
         self._correction = 0.0
 
 
+STEER_REQUEST = 0.01  # rad/s: the turn-only command (0, +-this) that turns a standing tricycle's wheel
+
+
 def next_steer(steer: float, v: float, omega: float, commanded: tuple[float, float], geometry, dt: float) -> float:
     """A tricycle's front-wheel angle one control period on, at most ``steer_rate_max dt`` from ``steer`` and
     within +-``steer_max`` (``geometry``: anything with wheelbase, steer_max and steer_rate_max). Moving (the

@@ -85,3 +85,26 @@ def test_turning_to_face_a_plan_gives_up_after_its_time():
     escape.waypoint(1.5, (1.0, 0.0))  # planned at 1.5 s
     assert escape.turn_first(math.radians(120), 16.0)
     assert not escape.turn_first(math.radians(120), 16.6)  # 15 s on, still not facing it: drive anyway
+
+
+def test_standing_still_makes_a_trap_before_the_period_is_up():
+    escape = TrapEscape(goal=(4.0, 0.0), radius=0.5, params=EscapeParams(period=30.0, standstill=10.0))
+    escape.hits.add(wall(2.0, -2.0, 2.0))
+    for k in range(95):  # 9.5 s rocking a millimetre to and fro
+        escape.waypoint(k * 0.1, (0.001 * (k % 2), 0.0))
+    assert not escape.escaping
+    escape.waypoint(10.0, (0.0, 0.0))
+    assert escape.escaping and escape.escapes == 1
+
+
+def test_a_re_plan_during_a_multi_point_turn_does_not_restart_its_clock():
+    escape = TrapEscape(goal=(4.0, 0.0), radius=0.5, params=EscapeParams(period=1.0, replan=20.0),
+                        multi_point=True)
+    escape.hits.add(wall(2.0, -2.0, 2.0))
+    escape.waypoint(0.0, (1.0, 0.0))
+    escape.waypoint(1.5, (1.0, 0.0))  # planned at 1.5 s: the turn begins
+    for time in (21.5, 41.5):  # re-planned twice while still turning
+        escape.waypoint(time, (1.0, 0.0))
+        assert escape.turn_first(math.radians(120), time)
+    assert escape.escapes == 3
+    assert not escape.turn_first(math.radians(120), 61.6)  # 60 s from the turn's start, not from the last plan

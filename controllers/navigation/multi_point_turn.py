@@ -1,0 +1,82 @@
+"""A tricycle's turn on the spot: the multi-point turn of a trapped FRC (issue 22; docs/decisions.md, "Multi-point
+turn").
+
+A differential drive that escapes a trap first turns in place to face its plan (``trap_escape``). A tricycle has no
+point turns (§3.6), and between boxes the dynamic window cannot turn it round: with the plan behind it every
+candidate is scaled down by alpha_3 alike, left and right score the same, and the robot rocks to and fro along its
+heading or stands with its wheel at the lock. This turns it the way a driver does, in legs:
+  - backwards with the wheel at the lock away from the plan's side (the nose swings towards the plan), then
+    forwards with the wheel at the lock on the plan's side, and so on;
+  - the first leg is whichever has the more room; a leg ends when its arc has less than ``room`` left before the
+    circle, enlarged by ``margin``, would touch a seen obstacle (DC_cd of the window, (3.33)), or after ``leg`` m;
+  - the wheel turns only while the robot stands (a turn-only command, ``locomotion.next_steer``), and speed changes
+    at the drive's acceleration limit.
+The caller stops asking once the plan lies within ``TrapEscape``'s facing angle. Not in the thesis.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from teamsim.controllers.skills.locomotion import STEER_REQUEST
+
+
+@dataclass(frozen=True)
+class TurnParams:
+    speed: float = 0.08  # m/s along a leg (at the lock, A's omega limit allows 0.13; slow, to stop short)
+    leg: float = 1.5  # m: a leg's longest
+    room: float = 0.03  # m of arc a leg keeps free beyond its braking distance
+    margin: float = 0.05  # m added to the robot's circle when measuring a leg's room
+    lock: float = 0.05  # rad: the wheel counts as at its lock within this
+
+
+class MultiPointTurn:
+    """Legs of a multi-point turn for the tricycle whose dynamic window is ``window``."""
+
+    def __init__(self, window, params: TurnParams = TurnParams()):
+        self.window = window
+        self.params = params
+        self.direction = 0  # +1 forwards, -1 backwards; 0 before the first leg
+        self.travelled = 0.0  # m along the current leg
+        self.idle_legs = 0  # legs in a row that ended before moving
+
+    def restart(self) -> None:
+        """A new turn: its first leg is chosen afresh."""
+        self.direction, self.travelled, self.idle_legs = 0, 0.0, 0
+
+    def command(self, state, points: np.ndarray, bearing: float) -> tuple[float, float] | None:
+        """(v, omega) for this cycle, or None when neither leg has room (two legs in a row ended before moving);
+        ``state``: the drive state (v, omega, steer); ``points``: obstacle points relative to the centre, robot
+        frame; ``bearing``: the plan's way relative to the heading (left > 0)."""
+        side = 1.0 if bearing >= 0 else -1.0
+        if self.direction == 0:
+            self.direction = 1 if self._room(1, side, points) >= self._room(-1, side, points) else -1
+        p, dt = self.params, self.window.dt
+        brake = self.window.limits.accel_max * dt
+        stopping = state.v ** 2 / (2 * self.window.limits.accel_max)
+        if self.travelled >= p.leg or self._room(self.direction, side, points) < stopping + p.room + p.speed * dt:
+            if state.v == 0.0:  # the leg is over: the next goes the other way
+                self.idle_legs = self.idle_legs + 1 if self.travelled < p.speed * dt else 0
+                self.direction, self.travelled = -self.direction, 0.0
+                return None if self.idle_legs >= 2 else (0.0, 0.0)
+            v = math.copysign(max(abs(state.v) - brake, 0.0), state.v)
+            return v, v * math.tan(state.steer) / self.window.steering.wheelbase
+        steer = self._steer(self.direction, side)
+        if state.v == 0.0 and abs(steer - state.steer) > p.lock:
+            return 0.0, math.copysign(STEER_REQUEST, steer)
+        v = min(max(self.direction * p.speed, state.v - brake), state.v + brake)
+        self.travelled += abs(v) * dt
+        return v, v * math.tan(steer) / self.window.steering.wheelbase
+
+    def _steer(self, direction: int, side: float) -> float:
+        """The wheel's lock for a leg: on the plan's side forwards, away from it backwards."""
+        return direction * side * self.window.steering.steer_max
+
+    def _room(self, direction: int, side: float, points: np.ndarray) -> float:
+        """How far the centre can go along the leg's arc before the enlarged circle touches a point (DC_cd)."""
+        v = direction * self.params.speed
+        omega = v * math.tan(self._steer(direction, side)) / self.window.steering.wheelbase
+        return float(self.window.collision_distances(np.array([v]), np.array([omega]), points,
+                                                     self.params.margin)[0])
