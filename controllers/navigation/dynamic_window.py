@@ -741,14 +741,18 @@ class DynamicWindowController:
             heading = modified_target_heading(points, heading, self.radius, self.direction, previous)
             self.previous_direction = heading + pose[2]
         turn_first = self.escape is not None and self.escape.turn_first(bearing, obs.time)
-        if self.turn is not None and turn_first:
+        if turn_first and self.turn is not None:  # a tricycle turns in legs
             command = self.turn.command(self.state, points, bearing)
             if command is not None:
                 return self._command(*command, f"{self.name} escape turn")
             self.escape.stop_turning()  # no room for a leg either way: the window drives
+            turn_first = False
         if self.turn is not None:
             self.turn.restart()
-        decision = self.window.decide(self.state, points, heading, d_tgt, self.v_min, 0.0 if turn_first else math.inf)
+        if turn_first:  # a differential drive turns in place towards the plan itself, not theta_tmod
+            decision = self.window.decide(self.state, points, bearing, d_tgt, self.v_min, v_cap=0.0)
+        else:
+            decision = self.window.decide(self.state, points, heading, d_tgt, self.v_min)
         if self.turn is not None and self._wedged(decision):
             return self._command(0.0, self.sweep * STEER_REQUEST, f"{self.name} sweep")
         self.last_decision = decision
@@ -826,7 +830,8 @@ class DynamicWindowController:
 
 class FRC(DynamicWindowController):
     """Final reactive controller: direction sensor + the full modified dynamic window (§3.6.2), and a way out of
-    the pockets the printed method circles in for good (``trap_escape``; issue 22)."""
+    the pockets the printed method circles in for good (``trap_escape``; issue 22), which a tricycle turns out of
+    in legs (``multi_point_turn``)."""
     method = Method.FRC
     escapes_traps = True
 

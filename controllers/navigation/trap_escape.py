@@ -14,7 +14,7 @@ re-planning in HRDU and §6.2):
     nearest cell outside the inflation when the robot stands beside a box), and follows it as HRD follows its
     plans (``path_following``), re-planning every ``replan`` seconds with what it has since seen, until its
     distance to the goal falls by ``progress`` below its best: then it is FRC again. A differential drive first
-    turns in place to face each new plan (``TrapEscape.turn_first``).
+    turns in place to face each new plan (``TrapEscape.turn_first``), a tricycle in legs (``multi_point_turn``).
 The thresholds are choices (docs/decisions.md, "FRC's trap escape").
 """
 from __future__ import annotations
@@ -113,11 +113,12 @@ class TrapEscape:
     def turn_first(self, heading: float, time: float) -> bool:
         """Whether to stop and turn in place towards the plan's way (``heading``: the bearing of its look-ahead
         point, relative to the robot) before driving: after each new plan, until facing it, for at most
-        ``turning`` seconds (the window turns the robot towards theta_tmod, which the direction sensor can bend
-        more than ``facing`` away from that bearing: without the limit the robot then stood for good). A slow
-        robot with a small angular acceleration otherwise prefers speed to turning (the speed term of (3.35)
-        varies more across its window than the heading term) and, next to boxes, can lock into a tight circle
-        that only just clears them."""
+        ``turning`` seconds (``multi_point_turning`` for a tricycle's legs). A slow robot with a small angular
+        acceleration otherwise prefers speed to turning (the speed term of (3.35) varies more across its window
+        than the heading term) and, next to boxes, can lock into a tight circle that only just clears them. The
+        controller turns towards this bearing itself, not the direction sensor's theta_tmod: turned towards
+        theta_tmod, which can lie more than ``facing`` away from it, a robot stood until the limit, then drove
+        for a few seconds until the next plan, and stood again (in physics: issue 22, "Physics spot check")."""
         self.turning = (self.turning and self.escaping and abs(heading) > self.params.facing
                         and time - self.turn_started < self.turn_limit)
         return self.turning

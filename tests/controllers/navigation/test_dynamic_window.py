@@ -12,6 +12,7 @@ from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
 from teamsim.controllers.base import Observation
+from teamsim.controllers.navigation import dynamic_window as dw
 from teamsim.controllers.navigation.dynamic_window import (FRC, HRDK, HRDU, ODW, ODWDS, RFRC, DriveState, DynamicWindow,
                                                            DynamicWindowParams, Method, NO_CONTACT, SteeringGeometry,
                                                            _PoseTracker)
@@ -390,6 +391,18 @@ def test_controller_waits_for_a_fix_and_stops_at_the_goal():
     at_goal = FRC(LIMITS, "diffdrive", 0.35, goal=(0.2, 0.0))
     command = at_goal(observation(0.0))
     assert (command.v, command.behaviour, at_goal.arrived) == (0.0, "arrived", True)
+
+
+def test_turning_to_face_an_escape_plan_turns_towards_the_plan_not_the_direction_sensor(monkeypatch):
+    # The plan's look-ahead point lies 90 degrees to the left; the direction sensor would aim straight ahead
+    # (theta_tmod = 0). Turned towards theta_tmod, a robot more than 30 degrees off its plan stood still.
+    monkeypatch.setattr(dw, "modified_target_heading", lambda *args: 0.0)
+    controller = FRC(LIMITS, "diffdrive", 0.35, goal=(5.0, 0.0))
+    monkeypatch.setattr(controller.escape, "waypoint", lambda time, centre: (0.0, 5.0))
+    monkeypatch.setattr(controller.escape, "turn_first", lambda heading, time: abs(heading) > math.radians(30))
+    for tick in range(5):
+        command = controller(observation(0.1 * tick))
+        assert command.v == 0.0 and command.omega > 0.0
 
 
 def test_pose_tracker_advances_the_last_fix_by_the_commands():
