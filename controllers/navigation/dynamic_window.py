@@ -114,9 +114,9 @@ from teamsim.controllers.navigation.astar import PlannerParams, WeightAdaptation
 from teamsim.controllers.navigation.occupancy_grid import Evidence, OccupancyGrid
 from teamsim.controllers.navigation.path_following import PathFollower, PathFollowing
 from teamsim.controllers.navigation.multi_point_turn import MultiPointTurn
-from teamsim.controllers.navigation.trap_escape import TrapEscape
 from teamsim.controllers.navigation.polar_histogram import (DirectionSensorParams, modified_target_heading,
                                                             target_heading, wrap)
+from teamsim.controllers.navigation.trap_escape import TrapEscape
 from teamsim.controllers.skills.locomotion import STEER_REQUEST, next_steer
 from teamsim.models.robot import DriveLimits
 
@@ -710,7 +710,7 @@ class DynamicWindowController:
             if self.escapes_traps else None
         # a trapped tricycle turns to face its plan in legs, having no point turns
         self.turn = MultiPointTurn(self.window) if self.escapes_traps and self.window.tricycle else None
-        self.sweep = 0.0  # +-1 while a wedged tricycle sweeps its wheel towards that lock (``_unwedge``)
+        self.sweep = 0.0  # +-1 while a wedged tricycle sweeps its wheel towards that lock (``_wedged``)
 
     @property
     def name(self) -> str:
@@ -743,6 +743,7 @@ class DynamicWindowController:
         turn_first = self.escape is not None and self.escape.turn_first(bearing, obs.time)
         if turn_first and self.turn is not None:  # a tricycle turns in legs
             command = self.turn.command(self.state, points, bearing)
+            self.sweep = 0.0
             if command is not None:
                 return self._command(*command, f"{self.name} escape turn")
             self.escape.stop_turning()  # no room for a leg either way: the window drives
@@ -765,7 +766,8 @@ class DynamicWindowController:
         done (the wheel at the lock it chose, ``_steer_at_rest``). Then the wheel sweeps from lock to lock (the
         window's own steer requests overridden meanwhile), so that the window meets every steering angle: with
         boxes close on both sides the lock it chose leads into one of them, and a straighter wheel leads out.
-        Ends when the window moves the robot. (Issue 22; docs/decisions.md, "Multi-point turn".)"""
+        Ends when the window moves the robot. Sets the sweep's direction as it goes. Not in the thesis (issue 22;
+        docs/decisions.md, "Multi-point turn")."""
         standing = self.state.v == 0.0 and decision.v == 0.0 and decision.branch in ("steer", "curvature", "brake")
         if not standing or (self.sweep == 0.0 and decision.branch == "steer"):
             self.sweep = 0.0
@@ -778,7 +780,7 @@ class DynamicWindowController:
     def waypoint(self, pose: tuple[float, float, float], centre: tuple[float, float], obs: Observation):
         """The point the direction sensor aims at: the goal itself for the reactive controllers, or a trapped
         FRC's way out (``trap_escape``)."""
-        return self.goal if self.escape is None else self.escape.waypoint(obs.time, centre)
+        return self.goal if self.escape is None else self.escape.waypoint(obs.time, centre, pose[2])
 
     def _contact(self, commanded: DriveState, velocity) -> np.ndarray:
         """Where a stall says the body touches, relative to the pose's reference point in the robot frame: the

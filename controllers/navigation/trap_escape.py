@@ -40,7 +40,8 @@ class EscapeParams:
     resolution: float = 0.1  # m, the hit grid's cell (the study's map resolution)
     margin: float = 3.0  # m of free cells planned around the hits, the robot and the goal
     standstill: float = 10.0  # s standing that also make a trap
-    still_radius: float = 0.05  # m: the centre moving no further than this counts as standing
+    still_radius: float = 0.05  # m: the centre moving no further than this counts as standing,
+    still_turn: float = 0.5  # rad: and turning no further than this (a point turn is not standing)
 
 
 class HitMap:
@@ -81,7 +82,7 @@ class TrapEscape:
         self.hits = HitMap(params.resolution)
         self.best = math.inf  # distance to the goal at the last progress
         self.best_time = 0.0
-        self.still_at, self.still_since = (math.inf, math.inf), 0.0  # where and since when the robot stands
+        self.still_at, self.still_heading, self.still_since = (math.inf, math.inf), 0.0, 0.0  # standing since
         self.follower: PathFollower | None = None
         self.planned_at = -math.inf
         self.escapes = 0  # plans made
@@ -92,11 +93,13 @@ class TrapEscape:
     def escaping(self) -> bool:
         return self.follower is not None
 
-    def waypoint(self, time: float, centre: tuple[float, float]) -> tuple[float, float]:
-        """Where to aim: the goal, or while escaping the escape path's look-ahead point."""
+    def waypoint(self, time: float, centre: tuple[float, float], heading: float = 0.0) -> tuple[float, float]:
+        """Where to aim: the goal, or while escaping the escape path's look-ahead point. ``heading`` (rad) tells a
+        turn on the spot from standing."""
         distance = math.dist(centre, self.goal)
-        if math.dist(centre, self.still_at) > self.params.still_radius:
-            self.still_at, self.still_since = centre, time
+        if (math.dist(centre, self.still_at) > self.params.still_radius
+                or abs(math.remainder(heading - self.still_heading, math.tau)) > self.params.still_turn):
+            self.still_at, self.still_heading, self.still_since = centre, heading, time
         if distance <= self.best - self.params.progress or self.best == math.inf:
             self.best, self.best_time = distance, time
             self.follower = None
@@ -106,14 +109,16 @@ class TrapEscape:
 
     def _trapped(self, time: float) -> bool:
         """No progress for ``period`` s, or no motion for ``standstill`` s (the centre within ``still_radius`` of
-        where it stood): a tricycle wedged between boxes rocks a millimetre at a time and need not wait a period."""
+        where it stood, the heading within ``still_turn``): a tricycle wedged between boxes rocks a millimetre at a
+        time and need not wait a period."""
         return (time - self.best_time >= self.params.period
                 or time - self.still_since >= self.params.standstill)
 
     def turn_first(self, heading: float, time: float) -> bool:
-        """Whether to stop and turn in place towards the plan's way (``heading``: the bearing of its look-ahead
-        point, relative to the robot) before driving: after each new plan, until facing it, for at most
-        ``turning`` seconds (``multi_point_turning`` for a tricycle's legs). A slow robot with a small angular
+        """Whether to turn towards the plan's way before driving on (``heading``: the bearing of its look-ahead
+        point, relative to the robot): on the spot, or a tricycle in legs; from a new plan while not already
+        turning, until facing it, for at most ``turning`` seconds (``multi_point_turning`` for a tricycle) from the
+        turn's start, which a re-plan meanwhile does not move. A slow robot with a small angular
         acceleration otherwise prefers speed to turning (the speed term of (3.35) varies more across its window
         than the heading term) and, next to boxes, can lock into a tight circle that only just clears them. The
         controller turns towards this bearing itself, not the direction sensor's theta_tmod: turned towards

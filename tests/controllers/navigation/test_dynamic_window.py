@@ -398,7 +398,7 @@ def test_turning_to_face_an_escape_plan_turns_towards_the_plan_not_the_direction
     # (theta_tmod = 0). Turned towards theta_tmod, a robot more than 30 degrees off its plan stood still.
     monkeypatch.setattr(dw, "modified_target_heading", lambda *args: 0.0)
     controller = FRC(LIMITS, "diffdrive", 0.35, goal=(5.0, 0.0))
-    monkeypatch.setattr(controller.escape, "waypoint", lambda time, centre: (0.0, 5.0))
+    monkeypatch.setattr(controller.escape, "waypoint", lambda time, centre, heading: (0.0, 5.0))
     monkeypatch.setattr(controller.escape, "turn_first", lambda heading, time: abs(heading) > math.radians(30))
     for tick in range(5):
         command = controller(observation(0.1 * tick))

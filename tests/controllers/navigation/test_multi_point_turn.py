@@ -39,8 +39,8 @@ def seen_points(body: KinematicBody, nav_world: NavWorld) -> np.ndarray:
 
 
 def drive_turn(nav_world: NavWorld, target: tuple[float, float], seconds: float = 90.0):
-    """Drive the turn until the target lies within 30 degrees of the heading; the legs' directions, the least gap
-    to a box, and whether it faced the target."""
+    """Drive the turn until the target lies within 30 degrees of the heading; the directions of the legs that
+    moved, the least gap to a box, and whether it faced the target."""
     body = KinematicBody(ROBOT, (0.0, 0.0, 0.0))
     turn = MultiPointTurn(window())
     state, legs, least_gap = DriveState(), [], math.inf
@@ -51,8 +51,8 @@ def drive_turn(nav_world: NavWorld, target: tuple[float, float], seconds: float 
             return legs, least_gap, True
         command = turn.command(state, seen_points(body, nav_world), bearing)
         assert command is not None
-        if not legs or legs[-1] != turn.direction:
-            legs.append(turn.direction)
+        if command[0] != 0.0 and (not legs or legs[-1] != math.copysign(1, command[0])):
+            legs.append(math.copysign(1, command[0]))  # a leg that moved, forwards (+1) or backwards (-1)
         steer = next_steer(state.steer, command[0], command[1], command, ROBOT, body.control_dt)
         x, y, heading, velocity = body.motion(Command(v=command[0], omega=command[1]))
         least_gap = min(least_gap, body.gap(nav_world, x, y, heading))
@@ -68,12 +68,12 @@ def test_in_a_pocket_it_turns_round_in_legs_without_touching():
     for target in ((-6.0, 1.0), (-6.0, -1.0)):
         legs, least_gap, faced = drive_turn(pocket, target)
         assert faced
-        assert len(legs) >= 2 and all(a == -b for a, b in zip(legs, legs[1:]))  # forth, back, ...: it alternates
-        assert least_gap > 0.0  # never touched a box (measured: 0.03 m)
+        assert len(legs) >= 2 and set(legs) == {1.0, -1.0}  # it moved both ways
+        assert least_gap > 0.0  # never touched a box
 
 
 def test_in_the_open_one_leg_does_it():
-    legs, least_gap, faced = drive_turn(world(), target=(-6.0, 1.0))
+    legs, _, faced = drive_turn(world(), target=(-6.0, 1.0))
     assert faced and len(legs) == 1
 
 
@@ -130,3 +130,33 @@ def test_a_tricycle_wedged_with_its_wheel_at_the_lock_sweeps_it_and_drives_on():
     moved, least_gap = drive_frc_from_the_lock(channel, sweep=True)
     assert moved > 0.5  # measured: 0.75 m in 40 s
     assert least_gap > 0.0
+
+
+def test_a_turn_begun_on_the_move_first_brakes_to_a_stop_then_sets_the_wheel():
+    turn = MultiPointTurn(window())
+    body = KinematicBody(ROBOT, (0.0, 0.0, 0.0))
+    points = seen_points(body, world(Box(1.2, 0.0, 0.3, 1.0)))  # a box ahead: the first leg goes backwards
+    state = DriveState(0.3, 0.0, 0.0)  # driving straight on at 0.3 m/s
+    speeds = []
+    while state.v != 0.0:
+        v, omega = turn.command(state, points, bearing=math.radians(150))
+        assert turn.direction == -1 and 0.0 <= v < state.v and omega == 0.0  # slowing, straight on, not reversing
+        speeds.append(v)
+        state = DriveState(v, omega, 0.0)
+    assert len(speeds) > 5  # within the drive's deceleration, not at once
+    v, omega = turn.command(state, points, bearing=math.radians(150))
+    assert v == 0.0 and omega < 0.0  # standing: the wheel goes to the right lock for the backward leg
+
+
+def test_with_no_room_for_a_leg_frc_ends_the_turn_and_the_window_drives(monkeypatch):
+    nav_world = world()
+    controller = navigation_controller("FRC", build_robot("tricycle", "red"), nav_world)
+    monkeypatch.setattr(controller.escape, "turn_first", lambda heading, time: True)
+    monkeypatch.setattr(controller.turn, "command", lambda state, points, bearing: None)
+    controller.escape.turning = True
+    body = KinematicBody(ROBOT, (0.0, 0.0, 0.0))
+    ranges = body.ranges(nav_world)
+    command = controller(Observation(time=0.0, robot="red", ir_raw=ranges, ir_range=ranges, ir_bearings=body.bearings,
+                                     pose=PoseFix(0.0, 0.0, 0.0, 0.0), velocity=(0.0, 0.0)))
+    assert not controller.escape.turning
+    assert command.behaviour == "frc" and command.v > 0.0  # the window's own choice: off towards the goal

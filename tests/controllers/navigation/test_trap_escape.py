@@ -108,3 +108,14 @@ def test_a_re_plan_during_a_multi_point_turn_does_not_restart_its_clock():
         assert escape.turn_first(math.radians(120), time)
     assert escape.escapes == 3
     assert not escape.turn_first(math.radians(120), 61.6)  # 60 s from the turn's start, not from the last plan
+
+
+def test_moving_or_turning_on_the_spot_is_not_standing():
+    escape = TrapEscape(goal=(4.0, 0.0), radius=0.35, params=EscapeParams(period=100.0, standstill=10.0))
+    escape.hits.add(wall(2.0, -2.0, 2.0))
+    for k in range(200):  # 20 s creeping 1 cm a second along the wall: no progress to speak of, but moving
+        escape.waypoint(k * 0.1, (1.0, 0.001 * k))
+    assert not escape.escaping
+    for k in range(200, 400):  # 20 s turning on the spot at 0.3 rad/s
+        escape.waypoint(k * 0.1, (1.0, 0.2), heading=0.03 * (k - 200))
+    assert not escape.escaping

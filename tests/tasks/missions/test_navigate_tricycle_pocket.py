@@ -37,5 +37,5 @@ def test_without_the_multi_point_turn_the_tricycle_stands_in_the_pocket(world):
 def test_frc_turns_the_tricycle_round_and_arrives(world):
     metrics = kinematic_metrics(world, build_robot("tricycle", "red"), "FRC", 450.0)
     assert metrics["success"] and metrics["failure"] == ""
-    assert metrics["nav_time"] < 250.0  # measured: 150 s
-    assert metrics["touches"] <= 3  # measured: 1
+    assert metrics["nav_time"] < 250.0  # measured: 153 s
+    assert metrics["touches"] <= 2  # measured: 1 (a refused motion, the robot halted)
