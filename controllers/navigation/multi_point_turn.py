@@ -27,7 +27,7 @@ from teamsim.controllers.skills.locomotion import STEER_REQUEST
 
 @dataclass(frozen=True)
 class TurnParams:
-    speed: float = 0.06  # m/s along a leg (slow, to stop short: 2.5 cm at A's limits at the lock)
+    speed: float = 0.06  # m/s along a leg (slow, to stop short: 4 cm at A's limits at the lock)
     leg: float = 1.5  # m: a leg's longest
     room: float = 0.03  # m of arc a leg keeps free beyond its braking distance
     margin: float = 0.05  # m added to the robot's circle when measuring a leg's room

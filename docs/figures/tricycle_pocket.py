@@ -24,7 +24,7 @@ FILE = Path("examples/navigate-tricycle-pocket.yaml")
 
 
 def trace(multi_point: bool):
-    """(time, x, y, heading, v, turning) of every tick, and the world."""
+    """The world, and (time, x, y, heading, v, turning) of every tick."""
     world = nav_world_of(load(read(FILE), mission_of("navigate"), FILE.parent))
     model = build_robot("tricycle", "red")
     controller = navigation_controller("FRC", model, world)
