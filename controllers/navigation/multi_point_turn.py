@@ -59,7 +59,7 @@ class MultiPointTurn:
         frame; ``bearing``: the plan's way relative to the heading (left > 0)."""
         p = self.params
         if self.direction == 0:
-            self.side = 1.0 if bearing >= 0 else -1.0
+            self.side = _side(bearing)
             self.direction = 1 if self._room(1, points) >= self._room(-1, points) else -1
         steer = self._steer(self.direction)
         if state.v != 0.0 and (state.v * self.direction < 0 or abs(steer - state.steer) > p.lock_tolerance):
@@ -71,18 +71,22 @@ class MultiPointTurn:
             # the leg is over: the next goes the other way, on the side the plan now lies
             self.idle_legs = self.idle_legs + 1 if self.travelled == 0.0 else 0
             self.direction, self.travelled = -self.direction, 0.0
-            self.side = 1.0 if bearing >= 0 else -1.0
+            self.side = _side(bearing)
             return None if self.idle_legs >= 2 else (0.0, 0.0)
         if state.v == 0.0 and abs(steer - state.steer) > p.lock_tolerance:
             return 0.0, math.copysign(STEER_REQUEST, steer)
         v = self.direction * min(abs(state.v) + self.speed_step, max(p.speed, abs(state.v) - self.speed_step))
         self.travelled += abs(v) * self.window.dt
-        return v, v * math.tan(steer) / self.window.steering.wheelbase
+        return v, self._turn_rate(v, steer)
 
     def _brake(self, state) -> tuple[float, float]:
         """Slow down along the wheel's present curvature, to exactly 0."""
         v = math.copysign(max(abs(state.v) - self.speed_step, 0.0), state.v)
-        return v, v * math.tan(state.steer) / self.window.steering.wheelbase
+        return v, self._turn_rate(v, state.steer)
+
+    def _turn_rate(self, v: float, steer: float) -> float:
+        """omega of the bicycle model at speed ``v`` with the wheel at ``steer``."""
+        return v * math.tan(steer) / self.window.steering.wheelbase
 
     def _steer(self, direction: int) -> float:
         """The wheel's lock for a leg: on the plan's side forwards, away from it backwards."""
@@ -91,6 +95,11 @@ class MultiPointTurn:
     def _room(self, direction: int, points: np.ndarray) -> float:
         """How far the centre can go along the leg's arc before the enlarged circle touches a point (DC_cd)."""
         v = direction * self.params.speed
-        omega = v * math.tan(self._steer(direction)) / self.window.steering.wheelbase
+        omega = self._turn_rate(v, self._steer(direction))
         return float(self.window.collision_distances(np.array([v]), np.array([omega]), points,
                                                      self.params.margin)[0])
+
+
+def _side(bearing: float) -> float:
+    """The plan's side: +1 left (bearing >= 0), -1 right."""
+    return 1.0 if bearing >= 0 else -1.0
