@@ -239,12 +239,15 @@ class GlobalInfo:
 
 
 class FeedbackSystem:
-    """M2 on its robot: the ch.5 feedback coordination every ``t_m`` s over the workers' reports."""
+    """M2 on its robot: the ch.5 feedback coordination every ``t_m`` s over the workers' reports. Not ``enabled``
+    (Table 8.1's level 1, "no feedback"), it takes the reports and does nothing with them: the task scores stay
+    the allocation's, and no failure is detected or reallocated."""
 
-    def __init__(self, name: str, coordinator: FeedbackCoordinator, t_m: float):
+    def __init__(self, name: str, coordinator: FeedbackCoordinator, t_m: float, enabled: bool = True):
         self.name = name
         self.coordinator = coordinator
         self.t_m = t_m
+        self.enabled = enabled
         self.next_check = t_m
         self.reports: dict[str, dict[str, Report]] = {}
         self.outbox: list[Packet] = []
@@ -258,8 +261,10 @@ class FeedbackSystem:
         if now + 1e-9 < self.next_check:
             return
         self.next_check += self.t_m
-        result = self.coordinator.update(self.reports)
-        self.reports = {}
+        reports, self.reports = self.reports, {}
+        if not self.enabled:
+            return
+        result = self.coordinator.update(reports)
         self.steps.append((now, result))
         self.outbox.append(Packet("scores", {"task_scores": result.task_scores}, SMALL_MESSAGE, None))
         if result.reallocated:

@@ -62,6 +62,7 @@ EXPECTED_PER_MINUTE = {
 }
 PLANNER_PER_MINUTE = {"plan": [0.442, 0.442], "comm": [10380.0]}  # Robot4 on W1, Table 5.31
 MAPPING = MappingParams(hit_cell="beyond")  # cells occupied when their centre is, as the true raster counts
+FEEDBACK_MODES = ("on", "off")  # off: Table 8.1's level 1, task scores as allocated and nobody reallocated
 TEAM_FORM = re.compile(r"^\[?\s*(\d+)[\s,]+(\d+)\s*\]?$")
 
 
@@ -79,6 +80,8 @@ class ExploreParams:
     world_seed: int = setting(-1, lo=-1, hi=2**31 - 1, meaning="world layout seed (-1: the trial seed)")
     backend: str = setting("physics", choices=("physics", "kinematic"),
                            meaning="physics (MuJoCo) or kinematic (no contacts, for studies)")
+    feedback: str = setting("on", choices=FEEDBACK_MODES,
+                            meaning="on: the ch.5 feedback coordination every T_m; off: none (Table 8.1 level 1)")
 
     def team_sizes(self) -> tuple[int, int]:
         match = TEAM_FORM.match(self.team.strip())
@@ -113,6 +116,7 @@ class ExploreTask:
     t_m: float = setting(60.0, lo=1.0, hi=3600.0, meaning="feedback period T_m, s")
     explored_threshold: float = setting(EXPLORED_THRESHOLD, lo=0.0, hi=1.0, meaning="EA_T of (6.18)")
     backend: str = setting("physics", choices=("physics", "kinematic"), meaning="physics or kinematic")
+    feedback: str = setting("on", choices=FEEDBACK_MODES, meaning="on: feedback coordination every T_m; off: none")
 
 
 @dataclass
@@ -192,7 +196,8 @@ class ExploreMission(ScenarioMission):
         bogs = [BogZone(**dataclasses.asdict(bog)) for bog in world.bogs]
         return Scenario(mission=self.name, arena=Arena(size=(params.size, params.size), boxes=boxes, bogs=bogs),
                         robots=robots, task=ExploreTask(planners, explorers, params.divisions, params.resolution,
-                                                        params.t_m, params.explored_threshold, params.backend))
+                                                        params.t_m, params.explored_threshold, params.backend,
+                                                        params.feedback))
 
     def duration_of(self, params: ExploreParams) -> float:
         """MET for the team (§8.2): 15000 s for one explorer, 5000 s for more."""
@@ -335,7 +340,7 @@ def team_controller(name: str, robot: RobotModel, info: dict) -> TeamRobot:
         info["team"]["global_info"] = global_info
     if name == m2:
         feedback = FeedbackSystem(name, FeedbackCoordinator(allocation, expected_achievement(specs, task.t_m)),
-                                  task.t_m)
+                                  task.t_m, enabled=task.feedback == "on")
         info["team"]["feedback"] = feedback
     spec = specs[name]
     offset = centre_offset(robot)

@@ -107,13 +107,17 @@ class KinematicTeam:
 
     def _ranges(self, name: str, body: KinematicBody) -> np.ndarray:
         """IR ranges to the boxes and walls, and to the other live robots' enclosing circles."""
-        ranges = body.ranges(self.world)
-        others = [m.body for other, m in self.members.items() if other != name and m.alive]
+        origins, directions = body.rays()
+        ranges = body.ranges(self.world, (origins, directions))
+        cx, cy = body.centre(body.x, body.y, body.heading)
+        reach = body.robot.ir_range + float(body.sensor_radius.max())  # a circle beyond it cannot be seen
+        others = [(centre, m.body.robot.radius) for other, m in self.members.items() if other != name and m.alive
+                  for centre in [m.body.centre(m.body.x, m.body.y, m.body.heading)]
+                  if math.dist(centre, (cx, cy)) - m.body.robot.radius <= reach]
         if not others:
             return ranges
-        centres = np.array([b.centre(b.x, b.y, b.heading) for b in others])
-        radii = np.array([b.robot.radius for b in others])
-        origins, directions = body.rays()
+        centres = np.array([centre for centre, _ in others])
+        radii = np.array([radius for _, radius in others])
         return np.minimum(ranges, circle_ranges(origins, directions, centres, radii, body.robot.ir_range))
 
     def _bumps(self, name: str, body: KinematicBody, x: float, y: float, heading: float) -> bool:

@@ -85,6 +85,13 @@ class NavWorld:
         hi = np.array([[b.x + b.half_x, b.y + b.half_y] for b in self.boxes]).reshape(-1, 2)
         return lo, hi
 
+    @functools.cached_property
+    def box_extents(self) -> tuple[np.ndarray, np.ndarray]:
+        """The boxes' centres and half-sides, (boxes, 2) each."""
+        centres = np.array([[b.x, b.y] for b in self.boxes]).reshape(-1, 2)
+        halves = np.array([[b.half_x, b.half_y] for b in self.boxes]).reshape(-1, 2)
+        return centres, halves
+
     @property
     def density(self) -> float:
         return float(self.occupancy.mean())
@@ -272,11 +279,18 @@ def _ray_ranges(origins, directions, lo, hi, half, max_range):  # noqa: PLR0913
 
 
 def clearance(world: NavWorld, x: float, y: float) -> float:
-    """Distance from a point to the nearest box or wall."""
-    half = world.size / 2
-    walls = half - max(abs(x), abs(y))
-    boxes = [math.hypot(max(abs(x - b.x) - b.half_x, 0.0), max(abs(y - b.y) - b.half_y, 0.0)) for b in world.boxes]
-    return min([walls] + boxes)
+    """Distance from a point to the nearest box or wall. The per-box offsets are numpy's (the same IEEE operations
+    as one box at a time); ``math.hypot`` of the nearest few gives the result to the bit, whatever numpy's hypot
+    rounds differently."""
+    walls = world.size / 2 - max(abs(x), abs(y))
+    centres, halves = world.box_extents
+    if not len(centres):
+        return walls
+    dx = np.maximum(np.abs(x - centres[:, 0]) - halves[:, 0], 0.0)
+    dy = np.maximum(np.abs(y - centres[:, 1]) - halves[:, 1], 0.0)
+    approx = np.hypot(dx, dy)
+    nearest = np.flatnonzero(approx <= approx.min() * (1 + 1e-9))
+    return min(walls, min(math.hypot(dx[k], dy[k]) for k in nearest))
 
 
 @dataclass(frozen=True)
@@ -335,8 +349,9 @@ class KinematicBody:
         directions = np.column_stack([np.cos(self.heading + self.bearings), np.sin(self.heading + self.bearings)])
         return np.array([cx, cy]) + self.sensor_radius[:, None] * directions, directions
 
-    def ranges(self, world: NavWorld) -> np.ndarray:
-        return ray_ranges(world, *self.rays(), self.robot.ir_range)
+    def ranges(self, world: NavWorld, rays: tuple[np.ndarray, np.ndarray] | None = None) -> np.ndarray:
+        """Ideal readings along ``rays`` (default: this pose's, ``rays()``)."""
+        return ray_ranges(world, *(rays or self.rays()), self.robot.ir_range)
 
     def motion(self, command, speed_scale: float = 1.0) -> tuple[float, float, float, tuple[float, float]]:
         """Where this tick's command would take the robot, and the odometry it would read."""

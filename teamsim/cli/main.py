@@ -19,6 +19,7 @@ CLEANUP_CONDITIONS = ("none", "kill-red", "radio-off", "break-gripper")
 BOX_EXPERIMENTS = ("robot-failure", "heterogeneity")  # teamsim.tasks.studies.box_pushing.EXPERIMENTS
 JANITORIAL_RHOS = (0.0, 0.1, 0.5, 2.0)  # teamsim.tasks.studies.janitorial_rho.JanitorialRhoStudy.rhos
 FORMATION_STRATEGIES = ("I", "II", "III", "IV")  # teamsim.controllers.behaviours.formation.STRATEGIES
+EXPLORATION_TEAMS = ("1 1", "1 3", "1 5")  # teamsim.tasks.studies.exploration.TEAMS
 # teamsim.tasks.studies.robustness.MISSIONS
 ROBUSTNESS_MISSIONS = ("wander", "navigate", "hazardous-waste", "box-pushing", "explore", "janitorial",
                        "bounding-overwatch", "formation")
@@ -151,6 +152,19 @@ def _build_parser() -> argparse.ArgumentParser:
     _duration_option(formation, "simulated seconds per run (mission default if unset)")
     _run_options(formation, workers=2, out="renders/study-formation")
 
+    exploration = studies.add_parser("exploration", help="Chand §8.3: exploration without feedback, teams [1 1], "
+                                                         "[1 3], [1 5] x densities x bogs (Table 8.1 level 1.1)")
+    exploration.add_argument("--worlds", type=_positive_int("--worlds"), help="worlds per environment type "
+                                                                              "(default 3; --full: 10)")
+    exploration.add_argument("--repeats", type=_positive_int("--repeats"), help="runs per world (default 1; "
+                                                                                "--full: 10)")
+    exploration.add_argument("--teams", type=_csv_of("team", EXPLORATION_TEAMS, _team), default=EXPLORATION_TEAMS,
+                             help="comma-separated [planners explorers] teams: 1-1,1-3,1-5 (default: all)")
+    exploration.add_argument("--ray", action="store_true", help="run the trials on a local Ray instance (pip "
+                                                                "install 'teamsim[ray]') instead of --workers")
+    _sweep_options(exploration, "the thesis's design: 10 worlds x 10 repeats per environment type (hours)",
+                   workers=2, out="renders/study-exploration")
+
     robust = studies.add_parser("robustness", help="every mission under every fault kind it supports, over seeds "
                                                    "(issue 29)")
     robust.add_argument("--seeds", default="1", metavar="N|A-B", help="trial seeds: N (0..N-1) or a range A-B "
@@ -229,6 +243,11 @@ def _csv_of(name: str, allowed: tuple | None, kind=str):
                                              f"{', '.join(map(str, allowed or ()))}")
         return values
     return parse
+
+
+def _team(text: str) -> str:
+    """A team written 1-3 (or "1 3") as the explore mission writes it, "1 3"."""
+    return " ".join(text.replace("-", " ").split())
 
 
 def _seconds(flag: str):
@@ -314,6 +333,15 @@ def cmd_study(args) -> int:
                                        workers=args.workers, out=args.out, duration=args.duration,
                                        resume=args.resume))
         print(f"wrote {out / 'report.md'}, {out / 'fig7-2.png'} and {out / 'results.csv'}")
+    elif args.study == "exploration":
+        from teamsim.tasks.studies.exploration import ExplorationStudy, run_study
+
+        full = args.full
+        out = run_study(ExplorationStudy(worlds=args.worlds or (10 if full else 3),
+                                         repeats=args.repeats or (10 if full else 1), seed=args.seed,
+                                         teams=args.teams, workers=args.workers, ray=args.ray, out=args.out,
+                                         resume=args.resume))
+        print(f"wrote {out / 'report.md'}, {out / 'exploration.png'} and {out / 'results.csv'}")
     elif args.study == "lalliance":
         from teamsim.tasks.studies.lalliance import run_study
 
@@ -407,6 +435,7 @@ def cmd_list(_args) -> int:
     print("  cleanup-faults   Parker §3.8.4: the cleanup with red killed, the radio off, a gripper broken")
     print("  box-pushing      Parker §6.1.2: an R-2 taken away and returned; an R-2 replaced by Genghis-II")
     print("  formation        Parker §7.2: keeping formation under strategies I-IV (Fig. 7-2)")
+    print("  exploration      Chand §8.3: exploration without feedback, teams [1 1], [1 3], [1 5]")
     print("  robustness       every mission under every fault kind it supports, over seeds (issue 29)")
     return 0
 

@@ -1,0 +1,255 @@
+"""``teamsim study exploration``: Chand's exploration experiment without feedback (§8.2-8.3, Table 8.1 level 1.1,
+Figs 8.2-8.6), re-run on the ``explore`` mission's kinematic backend.
+
+Environment types: obstacle densities 5, 10 and 15 %, each without bogs and with about 5 % boggy terrain (§8.2).
+Each type has ``worlds`` worlds drawn from the study seed, and each world runs ``repeats`` times with trial seeds
+``seed .. seed + repeats - 1`` (the sensing and positioning noise). Every team [1 1], [1 3], [1 5] runs the same
+worlds and seeds, so team comparisons are paired run by run, as the thesis's t-tests were. The thesis's design is
+10 worlds x 10 repeats (``--full``); the default is 3 x 1.
+
+Metrics (§8.1, (8.1)): ET, the exploration time (MET when the team did not finish: 15000 s for [1 1], 5000 s for
+the larger teams, §8.2), PAE, the share of the world explored, and ER = PAE / ET. Every run that ended by
+finishing or at MET counts; a run that ended otherwise (``unstable``, ``error``) is reported and left out of the
+comparisons with its pairs.
+"""
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from teamsim.config import TrialConfig
+from teamsim.files import write_atomic, write_csv
+from teamsim.plots import pyplot, save_figure
+from teamsim.stats import paired_t_test, ratio_ci
+from teamsim.sweep import JOURNAL_NAME, run_trials
+from teamsim.tasks.missions.explore import ExploreParams, team_duration
+from teamsim.tasks.studies.findings import Finding, ratio_text, table
+
+TEAMS = ("1 1", "1 3", "1 5")  # [planners explorers], §8.2
+DENSITIES = (0.05, 0.10, 0.15)
+BOG_SHARE = 0.05  # "about 5 % boggy terrain" (§8.2)
+COLUMNS = ("team", "density", "bogs", "world", "repeat", "seed", "world_seed", "status", "finished",
+           "exploration_time", "explored_share", "exploration_rate", "map_accuracy", "boggy_environments",
+           "bogs_found", "real_time_factor")
+MEASURED = ("exploration_time", "explored_share", "exploration_rate")
+LABEL = {"exploration_time": "ET (s)", "explored_share": "PAE (share explored)", "exploration_rate": "ER (1/s)"}
+VALID = ("completed", "failed")  # finished, or ran to MET: both are results (§8.2 counts a run at MET with ET = MET)
+# §8.3, [1 1] as the baseline unless said: (team, baseline, metric, the thesis's ratio team/baseline)
+THESIS = (("1 3", "1 1", "exploration_time", 0.321), ("1 3", "1 1", "explored_share", 1.589),
+          ("1 3", "1 1", "exploration_rate", 4.80), ("1 5", "1 1", "exploration_time", 0.245),
+          ("1 5", "1 1", "explored_share", 1.648), ("1 5", "1 1", "exploration_rate", 7.28),
+          ("1 5", "1 3", "exploration_time", 0.763), ("1 5", "1 3", "explored_share", 1.036),
+          ("1 5", "1 3", "exploration_rate", 1.52))
+NAME = {"exploration_time": "ET", "explored_share": "area (PAE)", "exploration_rate": "ER"}
+
+
+@dataclass(frozen=True)
+class ExplorationStudy:
+    worlds: int = 3  # per environment type (the thesis: 10)
+    repeats: int = 1  # runs per world (the thesis: 10)
+    seed: int = 0
+    teams: tuple[str, ...] = TEAMS
+    densities: tuple[float, ...] = DENSITIES
+    bogs: tuple[bool, ...] = (False, True)
+    workers: int | None = None
+    ray: bool = False  # run the trials on a local Ray instance instead of worker processes
+    out: Path = Path("renders/study-exploration")
+    resume: bool = False
+
+
+def world_seed(study_seed: int, density: float, bogs: bool, world: int) -> int:
+    """The layout seed of world ``world`` of an environment type: distinct per type, from the study seed."""
+    key = [study_seed, round(density * 1000), int(bogs), world]
+    return int(np.random.SeedSequence(key).generate_state(1)[0] % 2**31)
+
+
+def trial_configs(study: ExplorationStudy) -> list[TrialConfig]:
+    configs = []
+    for density in study.densities:
+        for bogs in study.bogs:
+            for world in range(study.worlds):
+                layout = world_seed(study.seed, density, bogs, world)
+                for repeat in range(study.repeats):
+                    for team in study.teams:
+                        params = ExploreParams(team=team, density=density, bog_share=BOG_SHARE if bogs else 0.0,
+                                               world_seed=layout, backend="kinematic", feedback="off")
+                        run_id = f"{team.replace(' ', '-')}_d{round(density * 100)}_{'bog' if bogs else 'dry'}_" \
+                                 f"w{world}_r{repeat}"
+                        configs.append(TrialConfig(mission="explore", seed=study.seed + repeat, params=params,
+                                                   out=str(study.out / "trials"), run_id=run_id))
+    return configs
+
+
+def result_row(config: TrialConfig, summary: dict) -> dict:
+    params: ExploreParams = config.params
+    metrics = summary.get("metrics") or {}
+    _, density, bogs, world, repeat = config.run_id.split("_")
+    return {"team": params.team, "density": params.density, "bogs": bogs == "bog", "world": int(world[1:]),
+            "repeat": int(repeat[1:]), "seed": config.seed, "world_seed": params.world_seed,
+            "status": summary["status"], "finished": bool(summary.get("completed", False)),
+            **{key: metrics.get(key) for key in MEASURED + ("map_accuracy",)},
+            "boggy_environments": len(metrics.get("boggy_environments") or ()),
+            "bogs_found": len(metrics.get("bogs_found") or ()), "real_time_factor": summary.get("real_time_factor")}
+
+
+def run_study(study: ExplorationStudy) -> Path:
+    began = time.perf_counter()
+    configs = trial_configs(study)
+    summaries = run_trials(configs, workers=study.workers, backend="ray" if study.ray else "process",
+                           journal=study.out / JOURNAL_NAME, resume=study.resume)
+    rows = [result_row(c, s) for c, s in zip(configs, summaries)]
+    return write_results(study, rows, time.perf_counter() - began)
+
+
+def write_results(study: ExplorationStudy, rows: list[dict], wall_s: float) -> Path:
+    """``results.csv``, ``report.md`` and ``exploration.png`` in ``study.out``."""
+    study.out.mkdir(parents=True, exist_ok=True)
+    write_csv(study.out / "results.csv", COLUMNS, rows)
+    plot_metrics(study.out / "exploration.png", rows, study)
+    write_atomic(study.out / "report.md", report(study, rows, wall_s).encode())
+    return study.out
+
+
+# -- statistics -----------------------------------------------------------------------------------------------------
+def pair_key(row: dict) -> tuple:
+    return row["density"], row["bogs"], row["world"], row["repeat"]
+
+
+def paired(rows: list[dict], key: str, team: str, baseline: str, **where) -> tuple[list[float], list[float]]:
+    """``key`` of ``team`` and of ``baseline`` over the runs (same world and seed) both ended validly."""
+    def values(which: str) -> dict:
+        return {pair_key(r): r[key] for r in rows if r["team"] == which and r["status"] in VALID
+                and r[key] is not None and all(r[k] == v for k, v in where.items())}
+    a, b = values(team), values(baseline)
+    keys = sorted(set(a) & set(b))
+    return [a[k] for k in keys], [b[k] for k in keys]
+
+
+def judged(ratio: float, thesis: float) -> str:
+    """**yes** when the change (ratio - 1) has the thesis's sign and half to twice its size, **partly** for another
+    change of that sign, **no** otherwise (the formation study's criterion); the table adds "not decided" at
+    p >= 0.05."""
+    if math.isnan(ratio):
+        return "n/a"
+    change, expected = ratio - 1, thesis - 1
+    if change * expected <= 0:
+        return "**no**"
+    return "yes" if 0.5 <= change / expected <= 2.0 else "partly"
+
+
+def claims(rows: list[dict], teams: tuple[str, ...]) -> list[Finding]:
+    found = []
+    for team, baseline, key, thesis in THESIS:
+        if team not in teams or baseline not in teams:
+            continue
+        a, b = paired(rows, key, team, baseline)
+        ratio, low, high = ratio_ci(a, b)
+        p = paired_t_test(a, b)[1]
+        found.append(Finding(f"[{team}] vs [{baseline}]: {NAME[key]}", f"x {thesis:.3g}",
+                             f"x {ratio:.3g} ({len(a)} pairs)", judged(ratio, thesis), p,
+                             ratio_text(f"[{team}]/[{baseline}]", ratio, low, high)))
+    if "1 1" in teams:
+        shares = [r["explored_share"] for r in rows if r["team"] == "1 1" and r["status"] in VALID]
+        mean = float(np.mean(shares)) if shares else math.nan
+        verdict = "n/a" if math.isnan(mean) else "yes" if 0.7 <= mean <= 0.9 else "**no**"
+        found.append(Finding("[1 1] explores at most about 80 % (mean PAE)", "about 80 %",
+                             f"{100 * mean:.1f} % ({len(shares)} runs)", verdict))
+    return found
+
+
+def cell(rows: list[dict], team: str, density: float, bogs: bool) -> list[dict]:
+    return [r for r in rows if r["team"] == team and r["density"] == density and r["bogs"] == bogs
+            and r["status"] in VALID]
+
+
+def mean_sem(values: list[float]) -> tuple[float, float]:
+    if not values:
+        return math.nan, math.nan
+    sem = float(np.std(values, ddof=1) / math.sqrt(len(values))) if len(values) > 1 else 0.0
+    return float(np.mean(values)), sem
+
+
+# -- report ---------------------------------------------------------------------------------------------------------
+def report(study: ExplorationStudy, rows: list[dict], wall_s: float) -> str:
+    runs = len(rows)
+    trial_s = sum(r["exploration_time"] / r["real_time_factor"] for r in rows
+                  if r["exploration_time"] and r["real_time_factor"])
+    lines = ["# Exploration without feedback (Chand §8.2-8.3, Table 8.1 level 1.1) re-run in teamsim", "",
+             f"{study.worlds} worlds x {study.repeats} repeats per environment type (the thesis: 10 x 10), study "
+             f"seed {study.seed}, kinematic backend, feedback off. Teams {', '.join(f'[{t}]' for t in study.teams)}"
+             f", the same worlds and trial seeds for each. MET {team_duration(1):g} s for [1 1], "
+             f"{team_duration(3):g} s for the larger teams. Per-run rows: `results.csv`.", "",
+             f"Wall time: {wall_s / 60:.1f} min for this invocation ({runs} runs; the trials' own time summed: "
+             f"{trial_s / 60:.1f} min; on {'Ray' if study.ray else f'{study.workers or 2} worker processes'}).", "",
+             "## Per team and environment", "",
+             "Means with their standard errors; `at MET`: runs that had not finished by MET.", "",
+             "| team | density | bogs | runs | ET (s) | PAE (%) | ER (1e-4/s) | at MET | map accuracy (%) |",
+             "|---|---|---|---|---|---|---|---|---|"]
+    for team in study.teams:
+        for density in study.densities:
+            for bogs in study.bogs:
+                runs_here = cell(rows, team, density, bogs)
+                if not runs_here:
+                    continue
+                et, et_se = mean_sem([r["exploration_time"] for r in runs_here])
+                pae, pae_se = mean_sem([100 * r["explored_share"] for r in runs_here])
+                er, er_se = mean_sem([1e4 * r["exploration_rate"] for r in runs_here])
+                acc = np.mean([100 * r["map_accuracy"] for r in runs_here])
+                at_met = sum(not r["finished"] for r in runs_here)
+                lines.append(f"| [{team}] | {100 * density:.0f} % | {'yes' if bogs else 'no'} | {len(runs_here)} | "
+                             f"{et:.0f} ± {et_se:.0f} | {pae:.1f} ± {pae_se:.1f} | {er:.2f} ± {er_se:.2f} | "
+                             f"{at_met} | {acc:.1f} |")
+    invalid = [r for r in rows if r["status"] not in VALID]
+    if invalid:
+        lines += ["", f"Runs left out ({len(invalid)}): " + ", ".join(
+            f"[{r['team']}] {100 * r['density']:.0f} % {'bogs ' if r['bogs'] else ''}world {r['world']} repeat "
+            f"{r['repeat']}: {r['status']}" for r in invalid)]
+    lines += ["", "## Against the thesis (§8.3)", "",
+              "Ratios team/baseline of the means over all environment types, paired run by run.", ""]
+    lines += table(claims(rows, study.teams), " (the change has the thesis's sign and half to twice its size)")
+    lines += ["", "Thesis: at 15 % density the runs reach MET, except [1 5] in non-boggy 15 % worlds, which finishes "
+              "early. teamsim, runs at MET at 15 %: " + "; ".join(
+                  f"[{t}] {'bogs' if b else 'no bogs'} {sum(not r['finished'] for r in cell(rows, t, 0.15, b))}/"
+                  f"{len(cell(rows, t, 0.15, b))}" for t in study.teams for b in study.bogs if 0.15 in study.densities),
+              "", "![ET, PAE and ER per team and density (Figs 8.2-8.6)](exploration.png)", "",
+              "## Why teamsim may differ", "", DIFFERENCES]
+    return "\n".join(lines) + "\n"
+
+
+DIFFERENCES = """\
+- The thesis gives no world generator beyond "random, evenly spaced" obstacles at a density, nor the obstacle size,
+  the bog shapes, the start positions or the robots of [1 1] and [1 3]; teamsim's are in `tasks/worlds/exploration`
+  and docs/explore.md.
+- Its explorers' thresholds (P_s, NS_min, NS_max, NS_sen, EA_T, the bog-detection PWM levels, "persistent poor
+  progress") are not given; teamsim's choices are in docs/decisions.md ("Exploration").
+- The kinematic backend has no contacts, as the thesis's MATLAB simulation had none; positioning and IR noise are
+  teamsim's models.
+"""
+
+
+# -- figures --------------------------------------------------------------------------------------------------------
+COLOURS = {"1 1": "tab:red", "1 3": "tab:blue", "1 5": "tab:green"}
+
+
+def plot_metrics(path: Path, rows: list[dict], study: ExplorationStudy) -> None:
+    """ET, PAE and ER against density, one line per team, solid without bogs and dashed with (Figs 8.2-8.6)."""
+    fig, axes = pyplot().subplots(1, 3, figsize=(14, 4.2))
+    x = [100 * d for d in study.densities]
+    for ax, key in zip(axes, MEASURED):
+        for team in study.teams:
+            for bogs in study.bogs:
+                stats = [mean_sem([r[key] for r in cell(rows, team, d, bogs)]) for d in study.densities]
+                ax.errorbar(x, [m for m, _ in stats], yerr=[s for _, s in stats], color=COLOURS.get(team),
+                            linestyle="--" if bogs else "-", marker="o", capsize=3,
+                            label=f"[{team}]{' bogs' if bogs else ''}")
+        ax.set(xlabel="obstacle density (%)", ylabel=LABEL[key], xticks=x)
+        ax.grid(alpha=0.3)
+    axes[0].legend(fontsize=8)
+    fig.suptitle(f"Exploration without feedback: means ± s.e., {study.worlds} worlds x {study.repeats} repeats per "
+                 "environment type")
+    fig.tight_layout()
+    save_figure(fig, path)
