@@ -43,14 +43,14 @@ Choices where the thesis is silent or inconsistent (also in docs/decisions.md):
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Iterable, Mapping, Sequence
 
 import numpy as np
 
 from teamsim.config import ConfigError
 from teamsim.controllers.allocation.devolution import Allocation, assign_workers, normalised, resource_utilisation
-from teamsim.controllers.allocation.spec import CATEGORIES, TaskSpec
+from teamsim.controllers.allocation.spec import CATEGORIES, FeedbackSpec, TaskSpec
 
 COMPLETE_FAILURE, PARTIAL_FAILURE, POOR_PERFORMANCE = "CF", "PF", "PP"
 
@@ -98,12 +98,18 @@ class FeedbackCoordinator:
     """The manager's feedback loop over an :class:`~teamsim.controllers.allocation.devolution.Allocation`.
 
     ``expected[robot][task][category]`` is RA' per T_m (Table 5.31), one value per achievement sub-category, for
-    every robot that may execute the task (every RTCM candidate). Call :meth:`update` every T_m.
+    every robot that may execute the task (every RTCM candidate). Call :meth:`update` every T_m. ``feedback``:
+    weights and thresholds to use instead of a task's own (an experiment's level, as Chand's Table 8.1 varies
+    them); ``detect_failures`` False: task scores only, no flag and no reallocation (Table 8.1 level 2).
     """
 
-    def __init__(self, allocation: Allocation, expected: Mapping[str, Mapping[str, Mapping[str, Sequence[float]]]]):
+    def __init__(self, allocation: Allocation, expected: Mapping[str, Mapping[str, Mapping[str, Sequence[float]]]],
+                 feedback: Mapping[str, FeedbackSpec] | None = None, detect_failures: bool = True):
         self.allocation = allocation
-        self.tasks: dict[str, TaskSpec] = {t: allocation.tasks[t] for t in allocation.rtcm}
+        feedback = feedback or {}
+        self.tasks: dict[str, TaskSpec] = {t: replace(allocation.tasks[t], feedback=feedback[t]) if t in feedback
+                                           else allocation.tasks[t] for t in allocation.rtcm}
+        self.detect_failures = detect_failures
         self.expected = {}
         for task_id, task in self.tasks.items():
             if task.feedback is None:
@@ -207,7 +213,7 @@ class FeedbackCoordinator:
         for task_id, robots in self.workers.items():
             feedback = self.tasks[task_id].feedback
             for robot in robots:
-                if robot not in alive:
+                if robot not in alive and self.detect_failures:
                     flags[robot, task_id] = COMPLETE_FAILURE
             monitored = self._monitor(task_id, {r: reports.get(r, {}).get(task_id) for r in robots if r in alive})
             for robot, values in monitored.items():
@@ -215,6 +221,8 @@ class FeedbackCoordinator:
                     continue
                 success[robot, task_id] = values
                 self.value[robot, task_id] = values.otes_ind
+                if not self.detect_failures:
+                    continue
                 if values.tes_ind < feedback.tes_threshold:
                     flags[robot, task_id] = PARTIAL_FAILURE
                 elif values.otes_ind < feedback.otes_threshold:

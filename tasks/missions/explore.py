@@ -27,7 +27,7 @@ import numpy as np
 from teamsim.config import ConfigError, setting
 from teamsim.controllers.allocation.devolution import Allocation, allocate
 from teamsim.controllers.allocation.feedback_coordination import FeedbackCoordinator
-from teamsim.controllers.allocation.spec import RobotSpec, load_robots, load_tasks
+from teamsim.controllers.allocation.spec import FeedbackSpec, RobotSpec, load_robots, load_tasks
 from teamsim.controllers.exploration.explorer import Explorer, ExplorerParams
 from teamsim.controllers.exploration.global_map import EXPLORED_THRESHOLD
 from teamsim.controllers.exploration.manager import EXPLORER, PLANNER, FeedbackSystem, GlobalInfo
@@ -62,7 +62,13 @@ EXPECTED_PER_MINUTE = {
 }
 PLANNER_PER_MINUTE = {"plan": [0.442, 0.442], "comm": [10380.0]}  # Robot4 on W1, Table 5.31
 MAPPING = MappingParams(hit_cell="beyond")  # cells occupied when their centre is, as the true raster counts
-FEEDBACK_MODES = ("on", "off")  # off: Table 8.1's level 1, task scores as allocated and nobody reallocated
+# Table 8.1's levels: off (level 1), task scores only (level 2), the whole feedback coordination (level 3)
+FEEDBACK_MODES = ("on", "scores", "off")
+# The explorers' feedback settings Table 8.1 varies; "table" keeps thesis_tasks.toml's (Table 5.29's)
+WEIGHT_SETS = {"W1": (0.0, 0.0, 0.5, 0.5), "W2": (0.1, 0.1, 0.4, 0.4), "W3": (0.2, 0.2, 0.3, 0.3),
+               "W4": (0.25, 0.25, 0.25, 0.25)}  # WS over [plan, comm, sense, act]
+POOR_THRESHOLDS = {"off": -1.0, "P1": 0.75, "P2": 0.65, "P3": 0.55, "P4": 0.45}  # OTES_T (5.20)
+PARTIAL_THRESHOLDS = {"off": -1.0, "F1": 0.05, "F2": 0.15, "F3": 0.2, "F4": 0.25}  # TES_T (5.19)
 TEAM_FORM = re.compile(r"^\[?\s*(\d+)[\s,]+(\d+)\s*\]?$")
 
 
@@ -80,8 +86,12 @@ class ExploreParams:
     world_seed: int = setting(-1, lo=-1, hi=2**31 - 1, meaning="world layout seed (-1: the trial seed)")
     backend: str = setting("physics", choices=("physics", "kinematic"),
                            meaning="physics (MuJoCo) or kinematic (no contacts, for studies)")
-    feedback: str = setting("on", choices=FEEDBACK_MODES,
-                            meaning="on: the ch.5 feedback coordination every T_m; off: none (Table 8.1 level 1)")
+    feedback: str = setting("on", choices=FEEDBACK_MODES, meaning="on: the ch.5 feedback coordination every T_m; "
+                            "scores: task scores only, no reallocation (Table 8.1 level 2); off: none (level 1)")
+    weights: str = setting("table", choices=("table", *WEIGHT_SETS), meaning="the explorers' WS (Table 8.1)")
+    poor: str = setting("table", choices=("table", *POOR_THRESHOLDS), meaning="the explorers' OTES_T (Table 8.1)")
+    partial: str = setting("table", choices=("table", *PARTIAL_THRESHOLDS),
+                           meaning="the explorers' TES_T (Table 8.1)")
 
     def team_sizes(self) -> tuple[int, int]:
         match = TEAM_FORM.match(self.team.strip())
@@ -116,7 +126,10 @@ class ExploreTask:
     t_m: float = setting(60.0, lo=1.0, hi=3600.0, meaning="feedback period T_m, s")
     explored_threshold: float = setting(EXPLORED_THRESHOLD, lo=0.0, hi=1.0, meaning="EA_T of (6.18)")
     backend: str = setting("physics", choices=("physics", "kinematic"), meaning="physics or kinematic")
-    feedback: str = setting("on", choices=FEEDBACK_MODES, meaning="on: feedback coordination every T_m; off: none")
+    feedback: str = setting("on", choices=FEEDBACK_MODES, meaning="on, scores (no reallocation) or off")
+    weights: str = setting("table", choices=("table", *WEIGHT_SETS), meaning="the explorers' WS")
+    poor: str = setting("table", choices=("table", *POOR_THRESHOLDS), meaning="the explorers' OTES_T")
+    partial: str = setting("table", choices=("table", *PARTIAL_THRESHOLDS), meaning="the explorers' TES_T")
 
 
 @dataclass
@@ -197,7 +210,7 @@ class ExploreMission(ScenarioMission):
         return Scenario(mission=self.name, arena=Arena(size=(params.size, params.size), boxes=boxes, bogs=bogs),
                         robots=robots, task=ExploreTask(planners, explorers, params.divisions, params.resolution,
                                                         params.t_m, params.explored_threshold, params.backend,
-                                                        params.feedback))
+                                                        params.feedback, params.weights, params.poor, params.partial))
 
     def duration_of(self, params: ExploreParams) -> float:
         """MET for the team (§8.2): 15000 s for one explorer, 5000 s for more."""
@@ -296,6 +309,15 @@ def scenario_allocation(scenario: Scenario) -> Allocation:
     return team_allocation(list(scenario.robots), scenario.task.planners, scenario.task.explorers)
 
 
+def explorer_feedback(allocation: Allocation, task: ExploreTask) -> FeedbackSpec:
+    """The explorers' feedback weights and thresholds: the task table's, with the task's Table 8.1 choices."""
+    spec = allocation.tasks[EXPLORER].feedback
+    return dataclasses.replace(
+        spec, ws=WEIGHT_SETS.get(task.weights, spec.ws),
+        otes_threshold=POOR_THRESHOLDS.get(task.poor, spec.otes_threshold),
+        tes_threshold=PARTIAL_THRESHOLDS.get(task.partial, spec.tes_threshold))
+
+
 def team_members(allocation: Allocation) -> set[str]:
     return set(allocation.managers.values()) | {r for robots in allocation.workers.values() for r in robots}
 
@@ -339,8 +361,10 @@ def team_controller(name: str, robot: RobotModel, info: dict) -> TeamRobot:
                                  explored_threshold=task.explored_threshold)
         info["team"]["global_info"] = global_info
     if name == m2:
-        feedback = FeedbackSystem(name, FeedbackCoordinator(allocation, expected_achievement(specs, task.t_m)),
-                                  task.t_m, enabled=task.feedback == "on")
+        coordinator = FeedbackCoordinator(allocation, expected_achievement(specs, task.t_m),
+                                          feedback={EXPLORER: explorer_feedback(allocation, task)},
+                                          detect_failures=task.feedback == "on")
+        feedback = FeedbackSystem(name, coordinator, task.t_m, enabled=task.feedback != "off")
         info["team"]["feedback"] = feedback
     spec = specs[name]
     offset = centre_offset(robot)

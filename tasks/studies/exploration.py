@@ -57,6 +57,7 @@ class ExplorationStudy:
     bogs: tuple[bool, ...] = (False, True)
     workers: int | None = None
     ray: bool = False  # run the trials on a local Ray instance instead of worker processes
+    duration: float | None = None  # simulated seconds per run; None: MET
     out: Path = Path("renders/study-exploration")
     resume: bool = False
 
@@ -80,7 +81,8 @@ def trial_configs(study: ExplorationStudy) -> list[TrialConfig]:
                         run_id = f"{team.replace(' ', '-')}_d{round(density * 100)}_{'bog' if bogs else 'dry'}_" \
                                  f"w{world}_r{repeat}"
                         configs.append(TrialConfig(mission="explore", seed=study.seed + repeat, params=params,
-                                                   out=str(study.out / "trials"), run_id=run_id))
+                                                   duration=study.duration, out=str(study.out / "trials"),
+                                                   run_id=run_id))
     return configs
 
 
@@ -181,8 +183,10 @@ def report(study: ExplorationStudy, rows: list[dict], wall_s: float) -> str:
     lines = ["# Exploration without feedback (Chand §8.2-8.3, Table 8.1 level 1.1) re-run in teamsim", "",
              f"{study.worlds} worlds x {study.repeats} repeats per environment type (the thesis: 10 x 10), study "
              f"seed {study.seed}, kinematic backend, feedback off. Teams {', '.join(f'[{t}]' for t in study.teams)}"
-             f", the same worlds and trial seeds for each. MET {team_duration(1):g} s for [1 1], "
-             f"{team_duration(3):g} s for the larger teams. Per-run rows: `results.csv`.", "",
+             f", the same worlds and trial seeds for each. " + (
+                 f"MET {team_duration(1):g} s for [1 1], {team_duration(3):g} s for the larger teams. "
+                 if study.duration is None else f"Runs cut at {study.duration:g} s (not the thesis's MET). ") +
+             "Per-run rows: `results.csv`.", "",
              f"Wall time: {wall_s / 60:.1f} min for this invocation ({runs} runs; the trials' own time summed: "
              f"{trial_s / 60:.1f} min; on {'Ray' if study.ray else f'{study.workers or 2} worker processes'}).", "",
              "## Per team and environment", "",

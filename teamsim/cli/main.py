@@ -162,6 +162,7 @@ def _build_parser() -> argparse.ArgumentParser:
                              help="comma-separated [planners explorers] teams: 1-1,1-3,1-5 (default: all)")
     exploration.add_argument("--ray", action="store_true", help="run the trials on a local Ray instance (pip "
                                                                 "install 'teamsim[ray]') instead of --workers")
+    _duration_option(exploration, "simulated seconds per run (default: MET, §8.2)")
     _sweep_options(exploration, "the thesis's design: 10 worlds x 10 repeats per environment type (hours)",
                    workers=2, out="renders/study-exploration")
 
@@ -339,8 +340,8 @@ def cmd_study(args) -> int:
         full = args.full
         out = run_study(ExplorationStudy(worlds=args.worlds or (10 if full else 3),
                                          repeats=args.repeats or (10 if full else 1), seed=args.seed,
-                                         teams=args.teams, workers=args.workers, ray=args.ray, out=args.out,
-                                         resume=args.resume))
+                                         teams=args.teams, workers=args.workers, ray=args.ray,
+                                         duration=args.duration, out=args.out, resume=args.resume))
         print(f"wrote {out / 'report.md'}, {out / 'exploration.png'} and {out / 'results.csv'}")
     elif args.study == "lalliance":
         from teamsim.tasks.studies.lalliance import run_study

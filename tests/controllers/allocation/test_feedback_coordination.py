@@ -3,6 +3,8 @@
 5-6."""
 from __future__ import annotations
 
+from dataclasses import replace
+
 import pytest
 
 from teamsim.config import ConfigError
@@ -183,3 +185,25 @@ def test_task_scores_follow_the_new_team(coordinator):
     assert step.task_scores["W2"]["Robot6"] > 0  # (5.6) among the new team until it reports
     step = run(coordinator, 1, {"Robot7": None})
     assert set(step.task_scores["W2"]) == {"Robot4", "Robot2", "Robot5", "Robot6"} and not step.flags
+
+
+def test_without_failure_detection_only_the_task_scores_change():
+    """Table 8.1 level 2: the scores follow the reports, but a silent or stuck robot is neither flagged nor
+    moved."""
+    coordinator = FeedbackCoordinator(allocate(load_tasks(), load_robots()), expected(), detect_failures=False)
+    run(coordinator, 1, {})
+    stuck = explorer([0, 0], 8000, 0, 0, 0.0, 10)
+    step = run(coordinator, 1, {"Robot2": {"W2": stuck}, "Robot7": None})
+    assert not step.flags and not step.reallocated
+    assert step.workers["W2"] == ["Robot4", "Robot2", "Robot5", "Robot7"]  # as allocated
+    assert step.task_scores["W2"]["Robot2"] < step.task_scores["W2"]["Robot5"]  # its score fell all the same
+
+
+def test_an_experiments_thresholds_replace_the_tasks_own():
+    """OTES_T raised to 0.99 (beyond Table 8.1's P1, to make the point): a robot near its best case is poor."""
+    allocation = allocate(load_tasks(), load_robots())
+    strict = replace(allocation.tasks["W2"].feedback, otes_threshold=0.99)
+    coordinator = FeedbackCoordinator(allocation, expected(), feedback={"W2": strict})
+    step = run(coordinator, 1, {})
+    assert set(step.flags.values()) == {"PP"} and step.reallocated
+    assert not run(FeedbackCoordinator(allocation, expected()), 1, {}).flags  # the table's 0.65: none

@@ -16,7 +16,8 @@ from teamsim.cli import main
 from teamsim.config import ConfigError, TrialConfig
 from teamsim.faults import parse_fault
 from teamsim.runner import run_trial
-from teamsim.tasks.missions.explore import ExploreParams, kinematic_trial, role_names, team_allocation
+from teamsim.tasks.missions.explore import (ExploreParams, ExploreTask, explorer_feedback, kinematic_trial,
+                                           role_names, team_allocation)
 
 SMALL = dict(size=19.2, divisions=2, t_m=30.0)  # four 9.6 m environments; feedback every 30 s
 
@@ -88,6 +89,27 @@ def test_a_broken_motor_is_a_partial_failure():
     flags = [f for f in run["metrics"]["feedback_flags"] if f["flag"] == "PF"]
     assert flags and flags[0]["t"] <= 60 + 3 * SMALL["t_m"]
     assert events(run, "explorer removed")[0]["robot"] == flags[0]["robot"]
+
+
+@pytest.mark.parametrize("feedback", ["off", "scores"])
+def test_without_the_feedback_coordination_a_broken_explorer_keeps_its_role(feedback):
+    """Table 8.1 levels 1 and 2: nobody flags the explorer whose motor broke, so nothing is reallocated (with
+    feedback on, the same fault is a partial failure: the test above)."""
+    params = ExploreParams(team="1 2", feedback=feedback, **SMALL)
+    config = TrialConfig(mission="explore", params=params, seed=2, duration=200.0,
+                         faults=[parse_fault("break-motor:explorer@60")])
+    metrics = kinematic_trial(config)["metrics"]
+    assert metrics["feedback_flags"] == [] and metrics["reallocations"] == 0
+    assert not events({"metrics": metrics}, "explorer removed")
+
+
+def test_table_8_1_settings_replace_the_explorers_weights_and_thresholds():
+    allocation = team_allocation([f"Robot{k}" for k in range(1, 9)], 1, 3)
+    table = allocation.tasks["W2"].feedback
+    assert explorer_feedback(allocation, ExploreTask()) == table
+    chosen = explorer_feedback(allocation, ExploreTask(weights="W3", poor="P1", partial="F2"))
+    assert (chosen.ws, chosen.otes_threshold, chosen.tes_threshold) == ((0.2, 0.2, 0.3, 0.3), 0.75, 0.15)
+    assert explorer_feedback(allocation, ExploreTask(poor="off")).otes_threshold == -1
 
 
 def test_a_wheeled_explorer_backs_out_of_a_bog_and_a_tracked_one_maps_it():

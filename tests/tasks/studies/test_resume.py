@@ -57,8 +57,8 @@ _NO_CLOCK = types.SimpleNamespace(perf_counter=lambda: 0.0)
 def _studies():
     """(name, run the study into a folder with resume or not, the module attribute that runs one trial, how a trial
     is run here, modules whose clock is pinned)."""
-    from teamsim.tasks.studies import (awareness, box_pushing, cleanup_faults, formation, janitorial_rho, lalliance,
-                                       navigation, robustness, two_tier_astar)
+    from teamsim.tasks.studies import (awareness, box_pushing, cleanup_faults, exploration, formation, janitorial_rho,
+                                       lalliance, navigation, robustness, two_tier_astar)
 
     return {
         "awareness": (lambda out, resume: awareness.run_study(awareness.AwarenessStudy(
@@ -69,6 +69,9 @@ def _studies():
         "box-pushing": (lambda out, resume: box_pushing.run_study(box_pushing.BoxPushingStudy(
             trials=2, experiments=("robot-failure",), workers=1, out=out, resume=resume)),
             (sweep, "_run_one"), _short, ()),
+        "exploration": (lambda out, resume: exploration.run_study(exploration.ExplorationStudy(
+            worlds=1, teams=("1 3",), densities=(0.05,), duration=SHORT_S, workers=1, out=out, resume=resume)),
+            (sweep, "_run_one"), _short, (exploration,)),
         "formation": (lambda out, resume: formation.run_study(formation.FormationStudy(
             runs=2, strategies=("I", "IV"), duration=SHORT_S, workers=1, out=out, resume=resume)),
             (sweep, "_run_one"), _short, ()),
