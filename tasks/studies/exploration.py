@@ -68,28 +68,32 @@ def world_seed(study_seed: int, density: float, bogs: bool, world: int) -> int:
     return int(np.random.SeedSequence(key).generate_state(1)[0] % 2**31)
 
 
+def runs(study) -> list[tuple[float, bool, int, int, int]]:
+    """(density, bogs, world, repeat, world seed) of every run a team makes in ``study``."""
+    return [(density, bogs, world, repeat, world_seed(study.seed, density, bogs, world))
+            for density in study.densities for bogs in study.bogs for world in range(study.worlds)
+            for repeat in range(study.repeats)]
+
+
+def explore_config(study, team: str, run: tuple, label: str, faults=(), **settings) -> TrialConfig:
+    """Run ``run`` (of :func:`runs`) of ``team`` on the kinematic backend, in a folder named by ``label``, the
+    team and the run; ``settings``: further ``ExploreParams``."""
+    density, bogs, world, repeat, layout = run
+    params = ExploreParams(team=team, density=density, bog_share=BOG_SHARE if bogs else 0.0, world_seed=layout,
+                           backend="kinematic", **settings)
+    run_id = f"{label}{team.replace(' ', '-')}_d{round(density * 100)}_{'bog' if bogs else 'dry'}_w{world}_r{repeat}"
+    return TrialConfig(mission="explore", seed=study.seed + repeat, params=params, duration=study.duration,
+                       faults=list(faults), out=str(study.out / "trials"), run_id=run_id)
+
+
 def trial_configs(study: ExplorationStudy) -> list[TrialConfig]:
-    configs = []
-    for density in study.densities:
-        for bogs in study.bogs:
-            for world in range(study.worlds):
-                layout = world_seed(study.seed, density, bogs, world)
-                for repeat in range(study.repeats):
-                    for team in study.teams:
-                        params = ExploreParams(team=team, density=density, bog_share=BOG_SHARE if bogs else 0.0,
-                                               world_seed=layout, backend="kinematic", feedback="off")
-                        run_id = f"{team.replace(' ', '-')}_d{round(density * 100)}_{'bog' if bogs else 'dry'}_" \
-                                 f"w{world}_r{repeat}"
-                        configs.append(TrialConfig(mission="explore", seed=study.seed + repeat, params=params,
-                                                   duration=study.duration, out=str(study.out / "trials"),
-                                                   run_id=run_id))
-    return configs
+    return [explore_config(study, team, run, "", feedback="off") for run in runs(study) for team in study.teams]
 
 
 def result_row(config: TrialConfig, summary: dict) -> dict:
     params: ExploreParams = config.params
     metrics = summary.get("metrics") or {}
-    _, density, bogs, world, repeat = config.run_id.split("_")
+    _, _, bogs, world, repeat = config.run_id.rsplit("_", 4)
     return {"team": params.team, "density": params.density, "bogs": bogs == "bog", "world": int(world[1:]),
             "repeat": int(repeat[1:]), "seed": config.seed, "world_seed": params.world_seed,
             "status": summary["status"], "finished": bool(summary.get("completed", False)),
@@ -123,10 +127,16 @@ def pair_key(row: dict) -> tuple:
 
 def paired(rows: list[dict], key: str, team: str, baseline: str, **where) -> tuple[list[float], list[float]]:
     """``key`` of ``team`` and of ``baseline`` over the runs (same world and seed) both ended validly."""
-    def values(which: str) -> dict:
-        return {pair_key(r): r[key] for r in rows if r["team"] == which and r["status"] in VALID
-                and r[key] is not None and all(r[k] == v for k, v in where.items())}
-    a, b = values(team), values(baseline)
+    return paired_by(rows, key, {"team": team, **where}, {"team": baseline, **where})
+
+
+def paired_by(rows: list[dict], key: str, first: dict, second: dict) -> tuple[list[float], list[float]]:
+    """``key`` of the rows matching ``first`` and of those matching ``second`` (column -> value), over the pair
+    keys (world and seed) where both ended validly."""
+    def values(where: dict) -> dict:
+        return {pair_key(r): r[key] for r in rows if r["status"] in VALID and r[key] is not None
+                and all(r[k] == v for k, v in where.items())}
+    a, b = values(first), values(second)
     keys = sorted(set(a) & set(b))
     return [a[k] for k in keys], [b[k] for k in keys]
 

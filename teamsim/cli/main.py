@@ -20,6 +20,7 @@ BOX_EXPERIMENTS = ("robot-failure", "heterogeneity")  # teamsim.tasks.studies.bo
 JANITORIAL_RHOS = (0.0, 0.1, 0.5, 2.0)  # teamsim.tasks.studies.janitorial_rho.JanitorialRhoStudy.rhos
 FORMATION_STRATEGIES = ("I", "II", "III", "IV")  # teamsim.controllers.behaviours.formation.STRATEGIES
 EXPLORATION_TEAMS = ("1 1", "1 3", "1 5")  # teamsim.tasks.studies.exploration.TEAMS
+FEEDBACK_LEVELS = ("task-score", "poor", "partial", "complete", "combined")  # teamsim.tasks.studies.feedback.LEVELS
 # teamsim.tasks.studies.robustness.MISSIONS
 ROBUSTNESS_MISSIONS = ("wander", "navigate", "hazardous-waste", "box-pushing", "explore", "janitorial",
                        "bounding-overwatch", "formation")
@@ -165,6 +166,23 @@ def _build_parser() -> argparse.ArgumentParser:
     _duration_option(exploration, "simulated seconds per run (default: MET, §8.2)")
     _sweep_options(exploration, "the thesis's design: 10 worlds x 10 repeats per environment type (hours)",
                    workers=2, out="renders/study-exploration")
+
+    feedback = studies.add_parser("feedback", help="Chand §8.4-8.5: feedback coordination against none, tuned "
+                                                   "level by level (Table 8.1 levels 2-3.4)")
+    feedback.add_argument("--levels", type=_csv_of("level", FEEDBACK_LEVELS), default=FEEDBACK_LEVELS,
+                          help=f"comma-separated (default: all, in §8.2's tuning order): {','.join(FEEDBACK_LEVELS)}")
+    feedback.add_argument("--worlds", type=_positive_int("--worlds"), help="worlds per environment type "
+                                                                           "(default 1; --full: 10)")
+    feedback.add_argument("--repeats", type=_positive_int("--repeats"), help="runs per world (default 1; "
+                                                                             "--full: 10)")
+    feedback.add_argument("--densities", type=_csv_of("density", (5, 10, 15), int), default=(5, 10, 15),
+                          help="obstacle densities in %% (default: 5,10,15)")
+    feedback.add_argument("--no-retune", action="store_true", help="tune at T_m 60 s only (skip re-running each "
+                                                                   "level's best at 180 and 300 s)")
+    feedback.add_argument("--ray", action="store_true", help="run the trials on a local Ray instance")
+    _duration_option(feedback, "simulated seconds per run (default: MET, §8.2)")
+    _sweep_options(feedback, "the thesis's design: 10 worlds x 10 repeats per environment type (days)",
+                   workers=2, out="renders/study-feedback")
 
     robust = studies.add_parser("robustness", help="every mission under every fault kind it supports, over seeds "
                                                    "(issue 29)")
@@ -343,6 +361,16 @@ def cmd_study(args) -> int:
                                          teams=args.teams, workers=args.workers, ray=args.ray,
                                          duration=args.duration, out=args.out, resume=args.resume))
         print(f"wrote {out / 'report.md'}, {out / 'exploration.png'} and {out / 'results.csv'}")
+    elif args.study == "feedback":
+        from teamsim.tasks.studies.feedback import FeedbackStudy, run_study
+
+        full = args.full
+        out = run_study(FeedbackStudy(levels=args.levels, worlds=args.worlds or (10 if full else 1),
+                                      repeats=args.repeats or (10 if full else 1), seed=args.seed,
+                                      densities=tuple(d / 100 for d in args.densities), retune_t_m=not args.no_retune,
+                                      workers=args.workers, ray=args.ray, duration=args.duration, out=args.out,
+                                      resume=args.resume))
+        print(f"wrote {out / 'report.md'}, {out / 'feedback.png'} and {out / 'results.csv'}")
     elif args.study == "lalliance":
         from teamsim.tasks.studies.lalliance import run_study
 
@@ -437,6 +465,7 @@ def cmd_list(_args) -> int:
     print("  box-pushing      Parker §6.1.2: an R-2 taken away and returned; an R-2 replaced by Genghis-II")
     print("  formation        Parker §7.2: keeping formation under strategies I-IV (Fig. 7-2)")
     print("  exploration      Chand §8.3: exploration without feedback, teams [1 1], [1 3], [1 5]")
+    print("  feedback         Chand §8.4-8.5: feedback coordination against none, level by level")
     print("  robustness       every mission under every fault kind it supports, over seeds (issue 29)")
     return 0
 

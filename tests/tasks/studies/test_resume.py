@@ -57,8 +57,8 @@ _NO_CLOCK = types.SimpleNamespace(perf_counter=lambda: 0.0)
 def _studies():
     """(name, run the study into a folder with resume or not, the module attribute that runs one trial, how a trial
     is run here, modules whose clock is pinned)."""
-    from teamsim.tasks.studies import (awareness, box_pushing, cleanup_faults, exploration, formation, janitorial_rho,
-                                       lalliance, navigation, robustness, two_tier_astar)
+    from teamsim.tasks.studies import (awareness, box_pushing, cleanup_faults, exploration, feedback, formation,
+                                       janitorial_rho, lalliance, navigation, robustness, two_tier_astar)
 
     return {
         "awareness": (lambda out, resume: awareness.run_study(awareness.AwarenessStudy(
@@ -72,6 +72,9 @@ def _studies():
         "exploration": (lambda out, resume: exploration.run_study(exploration.ExplorationStudy(
             worlds=1, teams=("1 3",), densities=(0.05,), duration=SHORT_S, workers=1, out=out, resume=resume)),
             (sweep, "_run_one"), _short, (exploration,)),
+        "feedback": (lambda out, resume: feedback.run_study(feedback.FeedbackStudy(
+            levels=("complete",), densities=(0.05,), bogs=(False,), duration=SHORT_S, retune_t_m=False, workers=1,
+            out=out, resume=resume)), (sweep, "_run_one"), _short, (feedback,)),
         "formation": (lambda out, resume: formation.run_study(formation.FormationStudy(
             runs=2, strategies=("I", "IV"), duration=SHORT_S, workers=1, out=out, resume=resume)),
             (sweep, "_run_one"), _short, ()),
@@ -115,7 +118,8 @@ def test_a_killed_study_resumes_to_the_same_report(name, tmp_path, monkeypatch):
     _set(monkeypatch, where, killed)
     with pytest.raises(KeyboardInterrupt):
         run_study(tmp_path / "resumed", False)
-    assert killed.calls == 1 and len((tmp_path / "resumed" / JOURNAL_NAME).read_text().splitlines()) == 1
+    journals = (tmp_path / "resumed").glob(f"{Path(JOURNAL_NAME).stem}*.jsonl")  # a study may keep one per stage
+    assert killed.calls == 1 and sum(len(j.read_text().splitlines()) for j in journals) == 1
     _set(monkeypatch, where, run)
     with pytest.raises(JournalError, match="--resume"):  # not without being asked
         run_study(tmp_path / "resumed", False)
@@ -174,6 +178,6 @@ def test_every_study_subcommand_takes_resume():
     parser = _build_parser()
     studies = parser._subparsers._group_actions[0].choices["study"]._subparsers._group_actions[0].choices
     assert set(studies) == {"navigation", "two-tier-astar", "lalliance", "awareness", "janitorial-rho",
-                            "cleanup-faults", "box-pushing", "formation", "robustness"}
+                            "cleanup-faults", "box-pushing", "formation", "robustness", "exploration", "feedback"}
     for name in studies:
         assert parser.parse_args(["study", name, "--resume", "x"]).resume == Path("x")

@@ -1,0 +1,73 @@
+"""The feedback study (Chand §8.4-8.5, Table 8.1 levels 2-3.4): each level's settings, forced failures drawn alike
+with and without feedback, the tuning order's choice of the best variant, and a small run through the CLI."""
+from __future__ import annotations
+
+import csv
+
+import pytest
+
+from teamsim.cli import main
+from teamsim.tasks.studies.exploration import runs
+from teamsim.tasks.studies.feedback import (LEVELS, THESIS_BEST, FeedbackStudy, baseline_configs, best_variant,
+                                            failable_explorers, forced_fault, level_configs, settings_of)
+
+
+def test_each_level_tunes_its_own_setting_and_keeps_the_best_of_the_levels_before():
+    best = {"weights": "W2", "poor": "P3", "partial": "F4"}
+    assert settings_of(LEVELS["task-score"], "W1", best) == {"weights": "W1", "poor": "off", "partial": "off"}
+    assert settings_of(LEVELS["poor"], "P4", best) == {"weights": "W2", "poor": "P4", "partial": "F2"}  # TES_T 0.15
+    assert settings_of(LEVELS["partial"], "F1", best) == {"weights": "W2", "poor": "P3", "partial": "F1"}
+    assert settings_of(LEVELS["combined"], "best", best) == best
+
+
+def test_a_forced_failure_strikes_an_explorer_that_is_not_the_planner_the_same_with_and_without_feedback():
+    study = FeedbackStudy(levels=("partial",), densities=(0.05, 0.10))
+    assert failable_explorers("1 3") == ["Robot2", "Robot5"]  # Robot4 plans and explores
+    faults = {forced_fault(study, "1 5", run, "complete") for run in runs(study)}
+    assert len(faults) == len(runs(study))  # drawn per world
+    assert all(f.startswith("kill:Robot") and "Robot4" not in f and 300 <= float(f.split("@")[1]) <= 1200
+               for f in faults)
+    baselines = {c.run_id.split("_", 1)[1]: c.faults for c in baseline_configs(study)}
+    tuned = level_configs(study, LEVELS["partial"], {t: dict(THESIS_BEST) for t in ("1 3", "1 5")}, 60.0)
+    assert {c.params.feedback for c in tuned} == {"on"}
+    for config in tuned:
+        assert config.faults == baselines[config.run_id.split("_", 1)[1]] and config.faults[0].kind == "break-motor"
+
+
+def rows_for(level: str, team: str, variant: str, rates: list[float]) -> list[dict]:
+    base = {"level": level, "team": team, "variant": variant, "t_m": 60.0 if level != "baseline" else "-",
+            "failure": "none", "density": 0.05, "bogs": False, "repeat": 0, "status": "completed"}
+    return [{**base, "world": k, "exploration_rate": r} for k, r in enumerate(rates)]
+
+
+def test_the_best_variant_has_the_highest_exploration_rate_against_no_feedback():
+    rows = (rows_for("baseline", "1 3", "-", [1.0, 2.0, 3.0]) + rows_for("poor", "1 3", "P1", [1.1, 2.1, 3.3])
+            + rows_for("poor", "1 3", "P2", [1.3, 2.4, 3.5]) + rows_for("poor", "1 3", "P3", [0.9, 2.0, 2.9])
+            + rows_for("poor", "1 3", "P4", []))
+    assert best_variant(rows, LEVELS["poor"], "1 3") == "P2"
+
+
+def test_a_small_study_writes_its_report_table_and_figure(tmp_path, capsys):
+    out = tmp_path / "study"
+    code = main(["study", "feedback", "--levels", "complete", "--densities", "5", "--duration", "30",
+                 "--no-retune", "--workers", "2", "--out", str(out)])
+    assert code == 0, capsys.readouterr().err
+    rows = list(csv.DictReader((out / "results.csv").open()))
+    # [1 3] and [1 5], dry and boggy: without feedback (level 1.3) and with (3.3), the same kill in each pair
+    assert len(rows) == 8 and {r["level"] for r in rows} == {"baseline", "complete"}
+    kills = {}
+    for r in rows:
+        kills.setdefault((r["team"], r["bogs"]), set()).add(r["fault"])
+    assert all(len(f) == 1 and next(iter(f)).startswith("kill:") for f in kills.values())
+    report = (out / "report.md").read_text()
+    assert "## Complete-failure feedback (level 3.3)" in report and "complete-failure feedback (level 3.3), [1 5]" \
+        in report
+    assert all((out / f"feedback.{kind}").stat().st_size > 0 for kind in ("png", "svg"))
+
+
+@pytest.mark.parametrize("argv, fragment", [(["--levels", "bogus"], "level 'bogus' not allowed"),
+                                            (["--densities", "7"], "density 7 not allowed")])
+def test_bad_input_is_one_line_and_exit_2(capsys, argv, fragment):
+    assert main(["study", "feedback", *argv]) == 2
+    err = capsys.readouterr().err.strip()
+    assert fragment in err and len(err.splitlines()) == 1
