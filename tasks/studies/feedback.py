@@ -62,7 +62,7 @@ LEVELS = {level.name: level for level in (
 )}
 THESIS_BEST = {"weights": "W3", "poor": "P1", "partial": "F2"}  # §8.4-8.5
 T_M = (60.0, 180.0, 300.0)
-FAILURE_WINDOW = (300.0, 1200.0)  # s: a forced failure strikes at a time drawn uniformly from it
+FAILURE_WINDOW = (200.0, 600.0)  # s: a forced failure strikes at a time drawn uniformly from it
 # (level, team, variant as the thesis names it, metric, the thesis's ratio feedback / no feedback), T_m 60 s
 THESIS = (("task-score", "1 3", "W3", "explored_share", 1.026),
           ("poor", "1 1", "P1", "exploration_time", 0.733), ("poor", "1 3", "P1", "exploration_time", 0.89),
