@@ -1,5 +1,5 @@
 """``teamsim study exploration``: Chand's exploration experiment without feedback (§8.2-8.3, Table 8.1 level 1.1,
-Figs 8.2-8.6), re-run on the ``explore`` mission's kinematic backend.
+Figs 8.2-8.6), re-run on the ``explore`` mission's kinematic backend (``backend="physics"`` for a spot check).
 
 Environment types: obstacle densities 5, 10 and 15 %, each without bogs and with about 5 % boggy terrain (§8.2).
 Each type has ``worlds`` worlds drawn from the study seed, and each world runs ``repeats`` times with trial seeds
@@ -58,6 +58,7 @@ class ExplorationStudy:
     workers: int | None = None
     ray: bool = False  # run the trials on a local Ray instance instead of worker processes
     duration: float | None = None  # simulated seconds per run; None: MET
+    backend: str = "kinematic"  # or "physics": every run a MuJoCo explore mission (the spot check)
     out: Path = Path("renders/study-exploration")
     resume: bool = False
 
@@ -75,19 +76,21 @@ def runs(study) -> list[tuple[float, bool, int, int, int]]:
             for repeat in range(study.repeats)]
 
 
-def explore_config(study, team: str, run: tuple, label: str, faults=(), **settings) -> TrialConfig:
-    """Run ``run`` (of :func:`runs`) of ``team`` on the kinematic backend, in a folder named by ``label``, the
-    team and the run; ``settings``: further ``ExploreParams``."""
+def explore_config(study, team: str, run: tuple, label: str, faults=(), backend: str = "kinematic",
+                   **settings) -> TrialConfig:
+    """Run ``run`` (of :func:`runs`) of ``team`` on the study's backend, in a folder named by ``label``, the team
+    and the run; ``settings``: further ``ExploreParams``."""
     density, bogs, world, repeat, layout = run
     params = ExploreParams(team=team, density=density, bog_share=BOG_SHARE if bogs else 0.0, world_seed=layout,
-                           backend="kinematic", **settings)
+                           backend=backend, **settings)
     run_id = f"{label}{team.replace(' ', '-')}_d{round(density * 100)}_{'bog' if bogs else 'dry'}_w{world}_r{repeat}"
     return TrialConfig(mission="explore", seed=study.seed + repeat, params=params, duration=study.duration,
                        faults=list(faults), out=str(study.out / "trials"), run_id=run_id)
 
 
 def trial_configs(study: ExplorationStudy) -> list[TrialConfig]:
-    return [explore_config(study, team, run, "", feedback="off") for run in runs(study) for team in study.teams]
+    return [explore_config(study, team, run, "", backend=study.backend, feedback="off") for run in runs(study)
+            for team in study.teams]
 
 
 def result_row(config: TrialConfig, summary: dict) -> dict:
@@ -202,7 +205,8 @@ def report(study: ExplorationStudy, rows: list[dict], wall_s: float) -> str:
                   if r["exploration_time"] and r["real_time_factor"])
     lines = ["# Exploration without feedback (Chand §8.2-8.3, Table 8.1 level 1.1) re-run in teamsim", "",
              f"{study.worlds} worlds x {study.repeats} repeats per environment type (the thesis: 10 x 10), study "
-             f"seed {study.seed}, kinematic backend, feedback off. Teams {', '.join(f'[{t}]' for t in study.teams)}"
+             f"seed {study.seed}, {study.backend} backend, feedback off. Teams "
+             f"{', '.join(f'[{t}]' for t in study.teams)}"
              f", the same worlds and trial seeds for each. " + (
                  f"MET {team_duration(1):g} s for [1 1], {team_duration(3):g} s for the larger teams. "
                  if study.duration is None else f"Runs cut at {study.duration:g} s (not the thesis's MET). ") +

@@ -161,6 +161,12 @@ def _build_parser() -> argparse.ArgumentParser:
                                                                                 "--full: 10)")
     exploration.add_argument("--teams", type=_csv_of("team", EXPLORATION_TEAMS, _team), default=EXPLORATION_TEAMS,
                              help="comma-separated [planners explorers] teams: 1-1,1-3,1-5 (default: all)")
+    exploration.add_argument("--densities", type=_csv_of("density", (5, 10, 15), int), default=(5, 10, 15),
+                             help="obstacle densities in %% (default: 5,10,15)")
+    exploration.add_argument("--terrain", type=_csv_of("terrain", ("dry", "bog")), default=("dry", "bog"),
+                             help="worlds without bogs (dry), with about 5 %% bogs (bog), or both (default)")
+    exploration.add_argument("--backend", choices=("kinematic", "physics"), default="kinematic",
+                             help="kinematic (default, as the thesis simulated) or physics (MuJoCo; a spot check)")
     exploration.add_argument("--ray", action="store_true", help="run the trials on a local Ray instance (pip "
                                                                 "install 'teamsim[ray]') instead of --workers")
     _duration_option(exploration, "simulated seconds per run (default: MET, §8.2)")
@@ -358,8 +364,10 @@ def cmd_study(args) -> int:
         full = args.full
         out = run_study(ExplorationStudy(worlds=args.worlds or (10 if full else 3),
                                          repeats=args.repeats or (10 if full else 1), seed=args.seed,
-                                         teams=args.teams, workers=args.workers, ray=args.ray,
-                                         duration=args.duration, out=args.out, resume=args.resume))
+                                         teams=args.teams, densities=tuple(d / 100 for d in args.densities),
+                                         bogs=tuple(t == "bog" for t in args.terrain), backend=args.backend,
+                                         workers=args.workers, ray=args.ray, duration=args.duration, out=args.out,
+                                         resume=args.resume))
         print(f"wrote {out / 'report.md'}, {out / 'exploration.png'} and {out / 'results.csv'}")
     elif args.study == "feedback":
         from teamsim.tasks.studies.feedback import FeedbackStudy, run_study

@@ -8,7 +8,7 @@ import math
 import pytest
 
 from teamsim.cli import main
-from teamsim.tasks.studies.exploration import ExplorationStudy, claims, judged, trial_configs
+from teamsim.tasks.studies.exploration import ExplorationStudy, claims, judged, run_study, trial_configs
 
 
 def test_every_team_runs_the_same_worlds_and_seeds_and_each_environment_type_its_own_worlds():
@@ -71,3 +71,31 @@ def test_bad_input_is_one_line_and_exit_2(capsys, argv, fragment):
     assert main(["study", "exploration", *argv]) == 2
     err = capsys.readouterr().err.strip()
     assert fragment in err and len(err.splitlines()) == 1
+
+
+def test_the_cli_picks_densities_terrain_and_backend(monkeypatch):
+    import teamsim.tasks.studies.exploration as exploration
+
+    studies = []
+    monkeypatch.setattr(exploration, "run_study", lambda study: studies.append(study) or study.out)
+    assert main(["study", "exploration", "--densities", "5", "--terrain", "bog", "--teams", "1-3",
+                 "--backend", "physics", "--worlds", "5"]) == 0
+    configs = trial_configs(studies[0])
+    assert len(configs) == 5 and {(c.params.density, c.params.bog_share, c.params.backend, c.params.team)
+                                  for c in configs} == {(0.05, 0.05, "physics", "1 3")}
+
+
+def test_the_study_on_ray_writes_what_the_worker_processes_write(tmp_path):
+    ray = pytest.importorskip("ray")
+    ray.init(num_cpus=2, include_dashboard=False, log_to_driver=False)
+    try:
+        rows = {}
+        for name, on_ray in (("ray", True), ("pool", False)):
+            study = ExplorationStudy(worlds=1, teams=("1 3",), densities=(0.05,), duration=10.0, ray=on_ray,
+                                     out=tmp_path / name, workers=2)
+            run_study(study)
+            rows[name] = [{k: v for k, v in r.items() if k != "real_time_factor"}
+                          for r in csv.DictReader((study.out / "results.csv").open())]
+    finally:
+        ray.shutdown()
+    assert len(rows["ray"]) == 2 and rows["ray"] == rows["pool"]
