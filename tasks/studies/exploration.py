@@ -33,8 +33,8 @@ TEAMS = ("1 1", "1 3", "1 5")  # [planners explorers], §8.2
 DENSITIES = (0.05, 0.10, 0.15)
 BOG_SHARE = 0.05  # "about 5 % boggy terrain" (§8.2)
 COLUMNS = ("team", "density", "bogs", "world", "repeat", "seed", "world_seed", "status", "finished",
-           "exploration_time", "explored_share", "exploration_rate", "map_accuracy", "boggy_environments",
-           "bogs_found", "real_time_factor")
+           "exploration_time", "explored_share", "exploration_rate", "map_accuracy", "partly_explored",
+           "unexplored", "boggy_environments", "bogs_found", "real_time_factor")
 MEASURED = ("exploration_time", "explored_share", "exploration_rate")
 LABEL = {"exploration_time": "ET (s)", "explored_share": "PAE (share explored)", "exploration_rate": "ER (1/s)"}
 VALID = ("completed", "failed")  # finished, or ran to MET: both are results (§8.2 counts a run at MET with ET = MET)
@@ -101,6 +101,8 @@ def result_row(config: TrialConfig, summary: dict) -> dict:
             "repeat": int(repeat[1:]), "seed": config.seed, "world_seed": params.world_seed,
             "status": summary["status"], "finished": bool(summary.get("completed", False)),
             **{key: metrics.get(key) for key in MEASURED + ("map_accuracy",)},
+            "partly_explored": (metrics.get("status") or {}).get("PE"),
+            "unexplored": (metrics.get("status") or {}).get("UE"),
             "boggy_environments": len(metrics.get("boggy_environments") or ()),
             "bogs_found": len(metrics.get("bogs_found") or ()), "real_time_factor": summary.get("real_time_factor")}
 
@@ -198,6 +200,26 @@ def mean_sem(values: list[float]) -> tuple[float, float]:
     return float(np.mean(values)), sem
 
 
+def causes(rows: list[dict], teams: tuple[str, ...]) -> list[str]:
+    """Per team: how many runs finished before MET, when, and the environments they left partly explored or
+    unexplored (what the ratios against [1 1] turn on: §6.4.2 never offers a PE environment again to the explorer
+    that left it, so a lone explorer ends with them)."""
+    lines = []
+    for team in teams:
+        ran = [r for r in rows if r["team"] == team and r["status"] in VALID]
+        done = [r for r in ran if r["finished"]]
+        if not ran:
+            continue
+        times = [r["exploration_time"] for r in done]
+        left = [r["partly_explored"] for r in ran if r["partly_explored"] is not None]
+        lines.append(f"- [{team}]: {len(done)} of {len(ran)} runs finished before MET"
+                     + (f" (ET {min(times):.0f}-{max(times):.0f} s)" if times else "")
+                     + (f", leaving {np.mean(left):.1f} of the environments partly explored on average"
+                        if left else "")
+                     + f", {sum(r['unexplored'] or 0 for r in ran)} unexplored in all.")
+    return lines
+
+
 # -- report ---------------------------------------------------------------------------------------------------------
 def report(study: ExplorationStudy, rows: list[dict], wall_s: float) -> str:
     runs = len(rows)
@@ -240,6 +262,10 @@ def report(study: ExplorationStudy, rows: list[dict], wall_s: float) -> str:
     lines += ["", "## Against the thesis (§8.3)", "",
               "Ratios team/baseline of the means over all environment types, paired run by run.", ""]
     lines += table(claims(rows, study.teams), " (the change has the thesis's sign and half to twice its size)")
+    lines += ["", "## Measured causes", ""] + causes(rows, study.teams) + [
+        "", "§6.4.2 never offers a partly explored environment again to the explorer that left it: a lone explorer "
+        "ends with them, a larger team hands them to another explorer. A team that finishes before MET has its ET "
+        "shortened and its PAE capped by what it left, which is what the ratios against [1 1] turn on."]
     lines += ["", "![ET, PAE and ER per team and density (Figs 8.2-8.6)](exploration.png)", "",
               "## Why teamsim may differ", "", DIFFERENCES]
     return "\n".join(lines) + "\n"
