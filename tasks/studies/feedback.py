@@ -81,8 +81,8 @@ THESIS = (("task-score", "1 3", "W3", "explored_share", 1.026),
           ("combined", "1 5", "best", "exploration_rate", 1.077))
 COLUMNS = ("level", "team", "variant", "t_m", "failure", "fault", "weights", "poor", "partial", "density", "bogs",
            "world", "repeat", "seed", "world_seed", "status", "finished", "exploration_time", "explored_share",
-           "exploration_rate", "map_accuracy", "boggy_environments", "bogs_found", "reallocations",
-           "real_time_factor")
+           "exploration_rate", "map_accuracy", "partly_explored", "unexplored", "boggy_environments", "bogs_found",
+           "reallocations", "flags", "detected_s", "real_time_factor")
 
 
 @dataclass(frozen=True)
@@ -177,10 +177,22 @@ def row_of(config, summary: dict) -> dict:
     level, variant, t_m = level_variant.rsplit("-", 2) if params.feedback != "off" else (
         "baseline", "-", "-")
     failure = "none" if not config.faults else "partial" if config.faults[0].kind == "break-motor" else "complete"
+    metrics = summary.get("metrics") or {}
+    flags = metrics.get("feedback_flags") or []
     return {**row, "level": level, "variant": variant, "t_m": t_m if t_m == "-" else float(t_m),
             "failure": failure, "fault": fault_text(config.faults[0]) if config.faults else "",
             "weights": params.weights, "poor": params.poor, "partial": params.partial,
-            "reallocations": (summary.get("metrics") or {}).get("reallocations")}
+            "reallocations": metrics.get("reallocations"),
+            "flags": " ".join(f"{kind}:{sum(f['flag'] == kind for f in flags)}" for kind in ("PP", "PF", "CF")),
+            "detected_s": detection_delay(config.faults, flags)}
+
+
+def detection_delay(faults, flags: list[dict]) -> float | None:
+    """Seconds from the forced failure to the feedback's first flag on the failed robot (None: never flagged)."""
+    if not faults:
+        return None
+    times = [f["t"] for f in flags if f["robot"] == faults[0].robot and f["t"] >= faults[0].time]
+    return round(min(times) - faults[0].time, 1) if times else None
 
 
 # -- the study --------------------------------------------------------------------------------------------------------
@@ -273,11 +285,33 @@ def report(study: FeedbackStudy, rows: list[dict], chosen: dict, wall_s: float) 
                     lines.append(f"| [{team}] | {variant} | {t_m:g} | " + " | ".join(cells) +
                                  f" | {'yes' if variant == variants[team] else ''} |")
         lines.append("")
+    lines += ["## What the feedback did", ""] + actions(rows, chosen) + [""]
     lines += ["## Against the thesis (T_m 60 s)", ""]
     lines += table(claims(rows, chosen), " (the change has the thesis's sign and half to twice its size)")
     lines += ["", "![ER with feedback over ER without, per level and variant](feedback.png)", "",
               "## Why teamsim may differ", "", DIFFERENCES]
     return "\n".join(lines) + "\n"
+
+
+def actions(rows: list[dict], chosen: dict) -> list[str]:
+    """Per level, team and variant at T_m 60 s: the runs in which the feedback reallocated, the flags it raised, and (with a
+    forced failure) in how many runs and how soon it flagged the failed explorer."""
+    lines = ["| level | team | variant | runs | reallocated in | flags (PP / PF / CF) | failed explorer flagged | "
+             "after (median s) |", "|---|---|---|---|---|---|---|---|"]
+    for name in chosen:
+        for team, variant in ((t, v) for t in LEVELS[name].teams for v in LEVELS[name].variants):
+            ran = [r for r in rows if r["level"] == name and r["team"] == team and r["variant"] == variant
+                   and r["t_m"] == T_M[0] and r["status"] in ("completed", "failed")]
+            if not ran:
+                continue
+            counts = [sum(int(part.split(":")[1]) for r in ran for part in r["flags"].split() if part.startswith(k))
+                      for k in ("PP", "PF", "CF")]
+            delays = [r["detected_s"] for r in ran if r["detected_s"] is not None]
+            forced = LEVELS[name].failure != "none"
+            lines.append(f"| {name} | [{team}] | {variant} | {len(ran)} | {sum(bool(r['reallocations']) for r in ran)} | "
+                         f"{' / '.join(map(str, counts))} | {f'{len(delays)} of {len(ran)}' if forced else '-'} | "
+                         f"{f'{np.median(delays):.0f}' if delays else '-'} |")
+    return lines
 
 
 def claims(rows: list[dict], chosen: dict) -> list[Finding]:
