@@ -294,8 +294,8 @@ def report(study: FeedbackStudy, rows: list[dict], chosen: dict, wall_s: float) 
 
 
 def actions(rows: list[dict], chosen: dict) -> list[str]:
-    """Per level, team and variant at T_m 60 s: the runs in which the feedback reallocated, the flags it raised, and (with a
-    forced failure) in how many runs and how soon it flagged the failed explorer."""
+    """Per level, team and variant at T_m 60 s: the runs in which the feedback reallocated, the flags it raised,
+    and (with a forced failure) in how many runs and how soon it flagged the failed explorer."""
     lines = ["| level | team | variant | runs | reallocated in | flags (PP / PF / CF) | failed explorer flagged | "
              "after (median s) |", "|---|---|---|---|---|---|---|---|"]
     for name in chosen:
@@ -308,7 +308,8 @@ def actions(rows: list[dict], chosen: dict) -> list[str]:
                       for k in ("PP", "PF", "CF")]
             delays = [r["detected_s"] for r in ran if r["detected_s"] is not None]
             forced = LEVELS[name].failure != "none"
-            lines.append(f"| {name} | [{team}] | {variant} | {len(ran)} | {sum(bool(r['reallocations']) for r in ran)} | "
+            reallocated = sum(bool(r["reallocations"]) for r in ran)
+            lines.append(f"| {name} | [{team}] | {variant} | {len(ran)} | {reallocated} | "
                          f"{' / '.join(map(str, counts))} | {f'{len(delays)} of {len(ran)}' if forced else '-'} | "
                          f"{f'{np.median(delays):.0f}' if delays else '-'} |")
     return lines
