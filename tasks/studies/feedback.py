@@ -348,8 +348,8 @@ def plot_ratios(path: Path, rows: list[dict], study: FeedbackStudy, chosen: dict
         width = 0.8 / len(level.teams)
         for k, team in enumerate(level.teams):
             ratios = [against_baseline(rows, name, team, v, T_M[0], "exploration_rate")[0] for v in level.variants]
-            ax.bar(np.arange(len(level.variants)) + k * width, ratios, width, color=COLOURS.get(team),
-                   label=f"[{team}]")
+            ax.bar(np.arange(len(level.variants)) + k * width, np.asarray(ratios) - 1.0, width, bottom=1.0,
+                   color=COLOURS.get(team), label=f"[{team}]")  # from 1: a change of a few % stays visible
         ax.axhline(1.0, color="black", linewidth=0.8)
         ax.set(xticks=np.arange(len(level.variants)) + 0.4 - width / 2, xticklabels=level.variants,
                title=level.what, ylabel="ER with / without feedback")
