@@ -7,9 +7,11 @@ import csv
 import pytest
 
 from teamsim.cli import main
+from teamsim.faults import parse_fault
 from teamsim.tasks.studies.exploration import runs
-from teamsim.tasks.studies.feedback import (LEVELS, THESIS_BEST, FeedbackStudy, baseline_configs, best_variant,
-                                            failable_explorers, forced_fault, level_configs, settings_of)
+from teamsim.tasks.studies.feedback import (LEVELS, THESIS_BEST, FeedbackStudy, actions, baseline_configs,
+                                            best_variant, claims, detection_delay, failable_explorers, forced_fault,
+                                            level_configs, settings_of)
 
 
 def test_each_level_tunes_its_own_setting_and_keeps_the_best_of_the_levels_before():
@@ -71,3 +73,21 @@ def test_bad_input_is_one_line_and_exit_2(capsys, argv, fragment):
     assert main(["study", "feedback", *argv]) == 2
     err = capsys.readouterr().err.strip()
     assert fragment in err and len(err.splitlines()) == 1
+
+
+def test_the_report_says_how_soon_the_failed_explorer_was_flagged_and_judges_the_thesiss_ratios():
+    fault = [parse_fault("break-motor:Robot5@300")]
+    flags = [{"t": 240.0, "robot": "Robot5", "flag": "PP"}, {"t": 360.0, "robot": "Robot2", "flag": "PP"},
+             {"t": 420.0, "robot": "Robot5", "flag": "PF"}]
+    assert detection_delay(fault, flags) == 120.0 and detection_delay(fault, flags[:2]) is None
+    base = {"team": "1 3", "density": 0.05, "bogs": False, "repeat": 0, "status": "completed", "failure": "partial"}
+    rows = [{**base, "level": "baseline", "variant": "-", "t_m": "-", "world": k, "exploration_rate": 1.0 + k,
+             "exploration_time": 3000.0, "explored_share": 0.9} for k in range(3)]
+    rows += [{**base, "level": "partial", "variant": "F2", "t_m": 60.0, "world": k, "exploration_rate": 1.3 + k,
+              "exploration_time": 2650.0 + k, "explored_share": 0.99, "reallocations": 1, "flags": "PP:0 PF:1 CF:0",
+              "detected_s": 60.0 + 60 * k} for k in range(3)]
+    assert "| partial | [1 3] | F2 | 3 | 3 | 0 / 3 / 0 | 3 of 3 | 120 |" in actions(rows, {"partial": {"1 3": "F2"}})
+    found = {f.claim: f for f in claims(rows, {"partial": {"1 3": "F2"}})}
+    er = found["partial-failure feedback (level 3.2), [1 3] F2: ER"]
+    assert er.teamsim == "x 1.15 (3 pairs)" and er.verdict == "yes"  # +15 % against +29.4 %: half to twice
+    assert found["partial-failure feedback (level 3.2), [1 3] F2: ET"].verdict == "yes"  # x 0.884 against 0.881
