@@ -208,9 +208,11 @@ class ExploreMission(ScenarioMission):
         boxes = [BoxObstacle(**dataclasses.asdict(box)) for box in world.nav.boxes]
         bogs = [BogZone(**dataclasses.asdict(bog)) for bog in world.bogs]
         return Scenario(mission=self.name, arena=Arena(size=(params.size, params.size), boxes=boxes, bogs=bogs),
-                        robots=robots, task=ExploreTask(planners, explorers, params.divisions, params.resolution,
-                                                        params.t_m, params.explored_threshold, params.backend,
-                                                        params.feedback, params.weights, params.poor, params.partial))
+                        robots=robots, task=ExploreTask(
+                            planners=planners, explorers=explorers, divisions=params.divisions,
+                            resolution=params.resolution, t_m=params.t_m, explored_threshold=params.explored_threshold,
+                            backend=params.backend, feedback=params.feedback, weights=params.weights,
+                            poor=params.poor, partial=params.partial))
 
     def duration_of(self, params: ExploreParams) -> float:
         """MET for the team (§8.2): 15000 s for one explorer, 5000 s for more."""

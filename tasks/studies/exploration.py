@@ -25,7 +25,7 @@ from teamsim.config import TrialConfig
 from teamsim.files import write_atomic, write_csv
 from teamsim.plots import pyplot, save_figure
 from teamsim.stats import paired_t_test, ratio_ci
-from teamsim.sweep import JOURNAL_NAME, run_trials
+from teamsim.sweep import JOURNAL_NAME, default_workers, run_trials
 from teamsim.tasks.missions.explore import ExploreParams, team_duration
 from teamsim.tasks.studies.findings import Finding, ratio_text, table
 
@@ -158,17 +158,14 @@ def judged(ratio: float, thesis: float) -> str:
     return "yes" if 0.5 <= change / expected <= 2.0 else "partly"
 
 
-def claims(rows: list[dict], teams: tuple[str, ...]) -> list[Finding]:
-    found = []
-    for team, baseline, key, thesis in THESIS:
-        if team not in teams or baseline not in teams:
-            continue
-        a, b = paired(rows, key, team, baseline)
-        ratio, low, high = ratio_ci(a, b)
-        p = paired_t_test(a, b)[1]
-        found.append(Finding(f"[{team}] vs [{baseline}]: {NAME[key]}", f"x {thesis:.3g}",
-                             f"x {ratio:.3g} ({len(a)} pairs)", judged(ratio, thesis), p,
-                             ratio_text(f"[{team}]/[{baseline}]", ratio, low, high)))
+def claims(rows: list[dict], teams: tuple[str, ...], ran_to_met: bool = True) -> list[Finding]:
+    """§8.3's ratios, then (when the runs were not cut short of MET) what it says of [1 1]'s share and of the
+    runs reaching MET."""
+    found = [ratio_finding(f"[{team}] vs [{baseline}]: {NAME[key]}", thesis, *paired(rows, key, team, baseline),
+                           f"[{team}]/[{baseline}]")
+             for team, baseline, key, thesis in THESIS if team in teams and baseline in teams]
+    if not ran_to_met:
+        return found
     if "1 1" in teams:
         shares = [r["explored_share"] for r in rows if r["team"] == "1 1" and r["status"] in VALID]
         mean = float(np.mean(shares)) if shares else math.nan
@@ -184,11 +181,18 @@ def claims(rows: list[dict], teams: tuple[str, ...]) -> list[Finding]:
     return found
 
 
+def ratio_finding(claim: str, thesis: float, a: list[float], b: list[float], label: str) -> Finding:
+    """The thesis's ratio of means beside teamsim's over the pairs (a, b), with its interval and p, judged."""
+    ratio, low, high = ratio_ci(a, b)
+    return Finding(claim, f"x {thesis:.3g}", f"x {ratio:.3g} ({len(a)} pairs)", judged(ratio, thesis),
+                   paired_t_test(a, b)[1], ratio_text(label, ratio, low, high))
+
+
 def verdict_of_share(held: int, of: int) -> str:
     return "yes" if held == of else "partly" if held else "**no**"
 
 
-def cell(rows: list[dict], team: str, density: float, bogs: bool) -> list[dict]:
+def valid_runs(rows: list[dict], team: str, density: float, bogs: bool) -> list[dict]:
     return [r for r in rows if r["team"] == team and r["density"] == density and r["bogs"] == bogs
             and r["status"] in VALID]
 
@@ -222,7 +226,7 @@ def causes(rows: list[dict], teams: tuple[str, ...]) -> list[str]:
 
 # -- report ---------------------------------------------------------------------------------------------------------
 def report(study: ExplorationStudy, rows: list[dict], wall_s: float) -> str:
-    runs = len(rows)
+    total = len(rows)
     trial_s = sum(r["exploration_time"] / r["real_time_factor"] for r in rows
                   if r["exploration_time"] and r["real_time_factor"])
     lines = ["# Exploration without feedback (Chand §8.2-8.3, Table 8.1 level 1.1) re-run in teamsim", "",
@@ -234,16 +238,16 @@ def report(study: ExplorationStudy, rows: list[dict], wall_s: float) -> str:
                  if study.duration is None else f"Runs cut at {study.duration:g} s (not the thesis's MET). ") +
              "Per-run rows: `results.csv`.", "",
              f"Wall time: {wall_s / 60:.1f} min for this invocation (resumed: the trials it ran) on "
-             f"{'Ray' if study.ray else f'{study.workers or 2} worker processes'}; {runs} runs, the trials' own "
-             f"time summed: {trial_s / 60:.1f} min.", "",
+             f"{'Ray' if study.ray else f'{study.workers or default_workers()} worker processes'}; {total} runs, the "
+             f"trials' own time summed: {trial_s / 60:.1f} min.", "",
              "## Per team and environment", "",
-             "Means with their standard errors; `at MET`: runs that had not finished by MET.", "",
+             "Means with their standard errors; `at MET`: runs that had not finished by MET (or by the cut).", "",
              "| team | density | bogs | runs | ET (s) | PAE (%) | ER (1e-4/s) | at MET | map accuracy (%) |",
              "|---|---|---|---|---|---|---|---|---|"]
     for team in study.teams:
         for density in study.densities:
             for bogs in study.bogs:
-                runs_here = cell(rows, team, density, bogs)
+                runs_here = valid_runs(rows, team, density, bogs)
                 if not runs_here:
                     continue
                 et, et_se = mean_sem([r["exploration_time"] for r in runs_here])
@@ -261,7 +265,8 @@ def report(study: ExplorationStudy, rows: list[dict], wall_s: float) -> str:
             f"{r['repeat']}: {r['status']}" for r in invalid)]
     lines += ["", "## Against the thesis (§8.3)", "",
               "Ratios team/baseline of the means over all environment types, paired run by run.", ""]
-    lines += table(claims(rows, study.teams), " (the change has the thesis's sign and half to twice its size)")
+    lines += table(claims(rows, study.teams, study.duration is None),
+                   " (the change has the thesis's sign and half to twice its size)")
     lines += ["", "## Measured causes", ""] + causes(rows, study.teams) + [
         "", "§6.4.2 never offers a partly explored environment again to the explorer that left it: a lone explorer "
         "ends with them, a larger team hands them to another explorer. A team that finishes before MET has its ET "
@@ -293,7 +298,7 @@ def plot_metrics(path: Path, rows: list[dict], study: ExplorationStudy) -> None:
     for ax, key in zip(axes, MEASURED):
         for team in study.teams:
             for bogs in study.bogs:
-                stats = [mean_sem([r[key] for r in cell(rows, team, d, bogs)]) for d in study.densities]
+                stats = [mean_sem([r[key] for r in valid_runs(rows, team, d, bogs)]) for d in study.densities]
                 ax.errorbar(x, [m for m, _ in stats], yerr=[s for _, s in stats], color=COLOURS.get(team),
                             linestyle="--" if bogs else "-", marker="o", capsize=3,
                             label=f"[{team}]{' bogs' if bogs else ''}")

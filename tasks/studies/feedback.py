@@ -14,7 +14,7 @@ paired two-sided t-tests are the thesis's. The levels, in the order of §8.2's t
 
 Tuning is at T_m = 60 s; the best variant of each level (per team, highest mean ER) is then re-run at 180 and 300
 s. A level not run leaves the thesis's best (W3, P1, F2). The failing explorer and the failure time come from the
-study seed, the world and the repeat, never a planner (docs/decisions.md, "Feedback study"): the same with and
+study seed, the world and the repeat, never a planner (docs/decisions.md, "The chapter 8 studies"): the same with and
 without feedback.
 """
 from __future__ import annotations
@@ -27,26 +27,27 @@ from pathlib import Path
 
 import numpy as np
 
+from teamsim.config import ConfigError
 from teamsim.faults import parse_fault
 from teamsim.files import write_atomic, write_csv
 from teamsim.plots import pyplot, save_figure
 from teamsim.stats import paired_t_test, ratio_ci
-from teamsim.sweep import run_trials
+from teamsim.sweep import JournalError, run_trials
 from teamsim.tasks.missions.explore import TABLE_5_22, team_allocation
 from teamsim.tasks.missions.explore import EXPLORER as EXPLORER_TASK
 from teamsim.tasks.missions.explore import PLANNER as PLANNER_TASK
-from teamsim.tasks.studies.exploration import (COLOURS, DENSITIES, MEASURED, NAME, TEAMS, explore_config,
-                                               judged, paired_by, result_row, runs)
-from teamsim.tasks.studies.findings import Finding, ratio_text, table
+from teamsim.tasks.studies.exploration import (COLOURS, DENSITIES, MEASURED, NAME, TEAMS, VALID, explore_config,
+                                               paired_by, ratio_finding, result_row, runs)
+from teamsim.tasks.studies.findings import Finding, table
 
 
 @dataclass(frozen=True)
 class Level:
     name: str
-    what: str
+    title: str
     teams: tuple[str, ...]
     failure: str  # forced failure: "none", "partial" or "complete"
-    mode: str  # explore's feedback setting
+    feedback_mode: str  # explore's feedback setting
     tuned: str | None  # the setting its variants try, or None (the best of the levels before)
     variants: tuple[str, ...]
 
@@ -97,14 +98,15 @@ class FeedbackStudy:
     workers: int | None = None
     ray: bool = False
     duration: float | None = None  # simulated seconds per run; None: MET
+    failure_window: tuple[float, float] = FAILURE_WINDOW  # s: when forced failures strike
     out: Path = Path("renders/study-feedback")
     resume: bool = False
 
 
 # -- the design -------------------------------------------------------------------------------------------------------
 def forced_fault(study: FeedbackStudy, team: str, run: tuple, failure: str) -> str | None:
-    """The fault spec of a forced failure in ``run``: an explorer that is not a planner, at a time in
-    ``FAILURE_WINDOW``, both drawn from the study seed, the world and the repeat (so the same with and without
+    """The fault spec of a forced failure in ``run``: an explorer that is not a planner, at a time in the study's
+    ``failure_window``, both drawn from the study seed, the world and the repeat (so the same with and without
     feedback)."""
     if failure == "none":
         return None
@@ -112,7 +114,7 @@ def forced_fault(study: FeedbackStudy, team: str, run: tuple, failure: str) -> s
     _, _, _, repeat, layout = run
     rng = np.random.default_rng([study.seed, layout, repeat])
     robot = candidates[int(rng.integers(len(candidates)))]
-    at = float(rng.uniform(*FAILURE_WINDOW))
+    at = float(rng.uniform(*study.failure_window))
     return f"{'break-motor' if failure == 'partial' else 'kill'}:{robot}@{at:.1f}"
 
 
@@ -139,48 +141,50 @@ def settings_of(level: Level, variant: str, best: dict) -> dict:
     return chosen
 
 
-def baseline_configs(study: FeedbackStudy) -> list:
-    """Level 1: each team of the levels asked for, with the forced failures they use, feedback off."""
-    wanted = sorted({(team, LEVELS[name].failure) for name in study.levels for team in LEVELS[name].teams},
+def baseline_configs(study: FeedbackStudy, levels, t_m: float) -> list[tuple]:
+    """Level 1 at ``t_m`` (the workers' report period and the ECT switch depend on it even without feedback):
+    each team of ``levels`` with the forced failures they use, feedback off. (config, what it is) pairs."""
+    wanted = sorted({(team, LEVELS[name].failure) for name in levels for team in LEVELS[name].teams},
                     key=lambda pair: (TEAMS.index(pair[0]), pair[1]))
-    configs = []
+    planned = []
     for team, failure in wanted:
         for run in runs(study):
             fault = forced_fault(study, team, run, failure)
-            configs.append(explore_config(study, team, run, f"baseline-{failure}_", feedback="off",
-                                          faults=[parse_fault(fault)] if fault else []))
-    return configs
+            config = explore_config(study, team, run, f"baseline-{failure}-{t_m:g}_", feedback="off", t_m=t_m,
+                                    faults=[parse_fault(fault)] if fault else [])
+            planned.append((config, {"level": "baseline", "variant": "-", "t_m": t_m, "failure": failure}))
+    return planned
 
 
-def level_configs(study: FeedbackStudy, level: Level, best: dict, t_m: float, variants=None) -> list:
-    """The runs of one level at ``t_m``: every variant (or ``variants``: team -> variant) of every team."""
-    configs = []
+def level_configs(study: FeedbackStudy, level: Level, best: dict, t_m: float, variants=None) -> list[tuple]:
+    """The runs of one level at ``t_m``: every variant (or ``variants``: team -> variant) of every team.
+    (config, what it is) pairs."""
+    planned = []
     for team in level.teams:
         for variant in (variants[team],) if variants else level.variants:
             settings = settings_of(level, variant, best[team])
             for run in runs(study):
                 fault = forced_fault(study, team, run, level.failure)
-                configs.append(explore_config(
-                    study, team, run, f"{level.name}-{variant}-{t_m:g}_", feedback=level.mode, t_m=t_m,
-                    faults=[parse_fault(fault)] if fault else [], **settings))
-    return configs
+                config = explore_config(study, team, run, f"{level.name}-{variant}-{t_m:g}_",
+                                        feedback=level.feedback_mode, t_m=t_m,
+                                        faults=[parse_fault(fault)] if fault else [], **settings)
+                planned.append((config, {"level": level.name, "variant": variant, "t_m": t_m,
+                                         "failure": level.failure}))
+    return planned
 
 
 def fault_text(fault) -> str:
     return f"{fault.kind}:{fault.robot}@{fault.time:g}"
 
 
-def row_of(config, summary: dict) -> dict:
-    level_variant = config.run_id.split("_", 1)[0]
+def row_of(config, meaning: dict, summary: dict) -> dict:
+    """One results.csv row: the run's measures, what it was (level, variant, T_m, failure) and what the feedback
+    did."""
     params = config.params
-    row = result_row(config, summary)
-    level, variant, t_m = level_variant.rsplit("-", 2) if params.feedback != "off" else (
-        "baseline", "-", "-")
-    failure = "none" if not config.faults else "partial" if config.faults[0].kind == "break-motor" else "complete"
     metrics = summary.get("metrics") or {}
     flags = metrics.get("feedback_flags") or []
-    return {**row, "level": level, "variant": variant, "t_m": t_m if t_m == "-" else float(t_m),
-            "failure": failure, "fault": fault_text(config.faults[0]) if config.faults else "",
+    return {**result_row(config, summary), **meaning,
+            "fault": fault_text(config.faults[0]) if config.faults else "",
             "weights": params.weights, "poor": params.poor, "partial": params.partial,
             "reallocations": metrics.get("reallocations"),
             "flags": " ".join(f"{kind}:{sum(f['flag'] == kind for f in flags)}" for kind in ("PP", "PF", "CF")),
@@ -197,13 +201,19 @@ def detection_delay(faults, flags: list[dict]) -> float | None:
 
 # -- the study --------------------------------------------------------------------------------------------------------
 def run_study(study: FeedbackStudy) -> Path:
+    if study.duration is not None and any(LEVELS[n].failure != "none" for n in study.levels) \
+            and study.duration <= study.failure_window[1]:
+        raise ConfigError(f"duration={study.duration:g}: the forced failures strike at {study.failure_window[0]:g}-"
+                          f"{study.failure_window[1]:g} s; give more, or levels without them (task-score, poor, "
+                          "combined)")
+    if study.resume and not (study.out / "trials-baseline.jsonl").exists():
+        raise JournalError(f"--resume {study.out}: no trials-baseline.jsonl there, nothing to resume")
     began = time.perf_counter()
-    rows = run_stage(study, "baseline", baseline_configs(study))
+    levels = [name for name in LEVELS if name in study.levels]  # §8.2's order, whatever the order asked
+    rows = run_stage(study, "baseline", baseline_configs(study, levels, T_M[0]))
     best = {team: dict(THESIS_BEST) for team in TEAMS}
     chosen = {}
-    for name in LEVELS:
-        if name not in study.levels:
-            continue
+    for name in levels:
         level = LEVELS[name]
         rows += run_stage(study, name, level_configs(study, level, best, T_M[0]))
         chosen[name] = {team: best_variant(rows, level, team) for team in level.teams}
@@ -211,49 +221,61 @@ def run_study(study: FeedbackStudy) -> Path:
             for team, variant in chosen[name].items():
                 best[team][level.tuned] = variant
     if study.retune_t_m and chosen:
-        configs = [c for name, variants in chosen.items() for t_m in T_M[1:]
-                   for c in level_configs(study, LEVELS[name], best, t_m, variants)]
-        rows += run_stage(study, "t_m", configs)
+        planned = [p for t_m in T_M[1:] for p in baseline_configs(study, levels, t_m)]
+        planned += [p for name, variants in chosen.items() for t_m in T_M[1:]
+                    for p in level_configs(study, LEVELS[name], best, t_m, variants)]
+        rows += run_stage(study, "t_m", planned)
     return write_results(study, rows, chosen, time.perf_counter() - began)
 
 
-def run_stage(study: FeedbackStudy, stage: str, configs: list) -> list[dict]:
+def run_stage(study: FeedbackStudy, stage: str, planned: list[tuple]) -> list[dict]:
     """One stage's runs, journalled in ``trials-<stage>.jsonl`` (``--resume`` skips those it holds; a stage the
     killed study never reached starts afresh)."""
     journal = study.out / f"trials-{stage}.jsonl"
+    configs = [config for config, _ in planned]
     summaries = run_trials(configs, workers=study.workers, backend="ray" if study.ray else "process",
                            journal=journal, resume=study.resume and journal.exists())
-    return [row_of(c, s) for c, s in zip(configs, summaries)]
+    return [row_of(config, meaning, s) for (config, meaning), s in zip(planned, summaries)]
 
 
-def against_baseline(rows: list[dict], level: str, team: str, variant: str, t_m: float, key: str):
+def pairs_against_baseline(rows: list[dict], level: str, team: str, variant: str, t_m: float, key: str,
+                           **where) -> tuple[list[float], list[float]]:
+    """``key`` with feedback and without (level 1 with the same failure and T_m), over the valid pairs;
+    ``where``: further columns to match (bogs=True)."""
+    return paired_by(rows, key, {"level": level, "team": team, "variant": variant, "t_m": t_m, **where},
+                     {"level": "baseline", "team": team, "failure": LEVELS[level].failure, "t_m": t_m, **where})
+
+
+def against_baseline(rows: list[dict], level: str, team: str, variant: str, t_m: float, key: str, **where):
     """(ratio feedback / no feedback of the means, low, high, p, pairs) of ``key``."""
-    failure = LEVELS[level].failure
-    a, b = paired_by(rows, key, {"level": level, "team": team, "variant": variant, "t_m": t_m},
-                     {"level": "baseline", "team": team, "failure": failure})
+    a, b = pairs_against_baseline(rows, level, team, variant, t_m, key, **where)
     ratio, low, high = ratio_ci(a, b)
     return ratio, low, high, paired_t_test(a, b)[1], len(a)
 
 
 def best_variant(rows: list[dict], level: Level, team: str) -> str:
-    """The variant with the highest mean ER at T_m 60 s (ties: the first)."""
+    """The variant whose ER against no feedback (ratio of the means over the valid pairs) is highest at T_m 60 s,
+    ties to the first; the thesis's best when no variant has two valid pairs."""
     def rate(variant: str) -> float:
         ratio = against_baseline(rows, level.name, team, variant, T_M[0], "exploration_rate")[0]
         return -math.inf if math.isnan(ratio) else ratio
-    return max(level.variants, key=rate)
+    best = max(level.variants, key=rate)
+    if rate(best) == -math.inf:
+        return THESIS_BEST.get(level.tuned, level.variants[0])
+    return best
 
 
 # -- report ---------------------------------------------------------------------------------------------------------
 def write_results(study: FeedbackStudy, rows: list[dict], chosen: dict, wall_s: float) -> Path:
     study.out.mkdir(parents=True, exist_ok=True)
     write_csv(study.out / "results.csv", COLUMNS, rows)
-    plot_ratios(study.out / "feedback.png", rows, study, chosen)
+    plot_ratios(study.out / "feedback.png", rows, chosen)
     write_atomic(study.out / "report.md", report(study, rows, chosen, wall_s).encode())
     return study.out
 
 
 def ratio_cell(rows, level, team, variant, t_m, key) -> str:
-    ratio, _, _, p, pairs = against_baseline(rows, level, team, variant, t_m, key)
+    ratio, _, _, p, _ = against_baseline(rows, level, team, variant, t_m, key)
     return "-" if math.isnan(ratio) else f"{ratio:.3f} (p {p:.2g})"
 
 
@@ -267,13 +289,14 @@ def report(study: FeedbackStudy, rows: list[dict], chosen: dict, wall_s: float) 
              f"backend, study seed {study.seed}. " + ("" if study.duration is None else
                                                       f"Runs cut at {study.duration:g} s (not the thesis's MET). ") +
              "Forced failures: an explorer that is not the planner, at a time in "
-             f"{FAILURE_WINDOW[0]:g}-{FAILURE_WINDOW[1]:g} s, drawn per world and repeat (`fault` in `results.csv`).",
-             "", f"Wall time: {wall_s / 60:.1f} min for this invocation ({len(rows)} runs).", "",
+             f"{study.failure_window[0]:g}-{study.failure_window[1]:g} s, drawn per world and repeat (`fault` in "
+             "`results.csv`).", "", f"Wall time: {wall_s / 60:.1f} min for this invocation (resumed: the trials it "
+             f"ran); {len(rows)} runs in this report.", "",
              "Cells: the ratio feedback / no feedback of the means over the paired runs, with the paired two-sided "
              "t-test's p.", ""]
     for name, variants in chosen.items():
         level = LEVELS[name]
-        lines += [f"## {level.what[0].upper()}{level.what[1:]}", "",
+        lines += [f"## {level.title[0].upper()}{level.title[1:]}", "",
                   "| team | variant | T_m (s) | ET | area (PAE) | ER | best |", "|---|---|---|---|---|---|---|"]
         for team in level.teams:
             for variant in level.variants:
@@ -286,7 +309,7 @@ def report(study: FeedbackStudy, rows: list[dict], chosen: dict, wall_s: float) 
                                  f" | {'yes' if variant == variants[team] else ''} |")
         lines.append("")
     lines += ["## What the feedback did", ""] + actions(rows, chosen) + [""]
-    lines += ["## Against the thesis (T_m 60 s)", ""]
+    lines += ["## Against the thesis (T_m 60 s, but for the T_m claim)", ""]
     lines += table(claims(rows, chosen), " (the change has the thesis's sign and half to twice its size)")
     lines += ["", "![ER with feedback over ER without, per level and variant](feedback.png)", "",
               "## Why teamsim may differ", "", DIFFERENCES]
@@ -301,7 +324,7 @@ def actions(rows: list[dict], chosen: dict) -> list[str]:
     for name in chosen:
         for team, variant in ((t, v) for t in LEVELS[name].teams for v in LEVELS[name].variants):
             ran = [r for r in rows if r["level"] == name and r["team"] == team and r["variant"] == variant
-                   and r["t_m"] == T_M[0] and r["status"] in ("completed", "failed")]
+                   and r["t_m"] == T_M[0] and r["status"] in VALID]
             if not ran:
                 continue
             counts = [sum(int(part.split(":")[1]) for r in ran for part in r["flags"].split() if part.startswith(k))
@@ -316,15 +339,42 @@ def actions(rows: list[dict], chosen: dict) -> list[str]:
 
 
 def claims(rows: list[dict], chosen: dict) -> list[Finding]:
-    found = []
-    for level, team, variant, key, thesis in THESIS:
-        if level not in chosen or team not in chosen[level]:
-            continue
-        ratio, low, high, p, pairs = against_baseline(rows, level, team, variant, T_M[0], key)
-        found.append(Finding(f"{LEVELS[level].what}, [{team}] {variant}: {NAME[key]}", f"x {thesis:.3g}",
-                             f"x {ratio:.3g} ({pairs} pairs)", judged(ratio, thesis), p,
-                             ratio_text("with/without", ratio, low, high)))
+    """§8.4-8.5's figures (``THESIS``), then claims 9, 12 and 13 of spec §7: task-score feedback's gain in boggy
+    worlds, complete-failure feedback's >= 97 % explored, combined feedback's insensitivity to T_m."""
+    found = [level_finding(rows, level, team, variant, key, thesis) for level, team, variant, key, thesis in THESIS
+             if team in chosen.get(level, {})]
+    if "1 3" in chosen.get("task-score", {}):
+        found.append(level_finding(rows, "task-score", "1 3", "W3", "explored_share", 1.052, bogs=True))
+    if "1 5" in chosen.get("task-score", {}):
+        ratio, _, _, p, pairs = against_baseline(rows, "task-score", "1 5", "W3", T_M[0], "explored_share",
+                                                 bogs=True)
+        found.append(Finding(f"{LEVELS['task-score'].title}, [1 5] W3, boggy worlds: area", "no significant gain",
+                             f"x {ratio:.3g} ({pairs} pairs)", "n/a" if math.isnan(ratio) else
+                             "yes" if p >= 0.05 or ratio <= 1 else "**no**", p))
+    for team, variant in chosen.get("complete", {}).items():
+        shares = [r["explored_share"] for r in rows if r["level"] == "complete" and r["team"] == team
+                  and r["t_m"] == T_M[0] and r["status"] in VALID]
+        mean = float(np.mean(shares)) if shares else math.nan
+        found.append(Finding(f"{LEVELS['complete'].title}, [{team}]: explored", ">= 97 %",
+                             f"{100 * mean:.1f} % ({len(shares)} runs)",
+                             "n/a" if math.isnan(mean) else "yes" if mean >= 0.97 else "**no**"))
+    for team, variant in chosen.get("combined", {}).items():
+        rates = [against_baseline(rows, "combined", team, variant, t_m, "exploration_rate")[0] for t_m in T_M]
+        measured = [r for r in rates if not math.isnan(r)]
+        verdict = "n/a" if len(measured) < 2 else "yes" if max(measured) - min(measured) <= 0.1 else "**no**"
+        found.append(Finding(f"{LEVELS['combined'].title}, [{team}]: insensitive to T_m", "alike at 60, 180, 300 s",
+                             "ER ratio " + " / ".join("-" if math.isnan(r) else f"{r:.3f}" for r in rates),
+                             verdict))
     return found
+
+
+def level_finding(rows: list[dict], level: str, team: str, variant: str, key: str, thesis: float,
+                  **where) -> Finding:
+    """The thesis's ratio (feedback / none) of ``key`` beside teamsim's at T_m 60 s, judged."""
+    a, b = pairs_against_baseline(rows, level, team, variant, T_M[0], key, **where)
+    scope = ", boggy worlds" if where.get("bogs") else ""
+    return ratio_finding(f"{LEVELS[level].title}, [{team}] {variant}{scope}: {NAME[key]}", thesis, a, b,
+                         "with/without")
 
 
 DIFFERENCES = """\
@@ -337,7 +387,7 @@ DIFFERENCES = """\
 """
 
 
-def plot_ratios(path: Path, rows: list[dict], study: FeedbackStudy, chosen: dict) -> None:
+def plot_ratios(path: Path, rows: list[dict], chosen: dict) -> None:
     """One panel per level: ER with / without feedback per variant at T_m 60 s, a bar per team."""
     names = list(chosen) or ["none"]
     fig, axes = pyplot().subplots(1, len(names), figsize=(4.2 * len(names), 4), squeeze=False)
@@ -352,7 +402,7 @@ def plot_ratios(path: Path, rows: list[dict], study: FeedbackStudy, chosen: dict
                    color=COLOURS.get(team), label=f"[{team}]")  # from 1: a change of a few % stays visible
         ax.axhline(1.0, color="black", linewidth=0.8)
         ax.set(xticks=np.arange(len(level.variants)) + 0.4 - width / 2, xticklabels=level.variants,
-               title=level.what, ylabel="ER with / without feedback")
+               title=level.title, ylabel="ER with / without feedback")
         ax.legend(fontsize=8)
         ax.grid(alpha=0.3, axis="y")
     fig.tight_layout()

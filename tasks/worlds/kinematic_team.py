@@ -29,6 +29,7 @@ from teamsim.tasks.worlds.navigation import KinematicBody, NavWorld
 FIRM_EFFORT = 0.05  # effort per unit of speed / v_max on firm ground
 BOG_EFFORT = 0.3  # effort per unit of speed / (traversability x v_max) in a bog
 KINEMATIC_FAULTS = ("kill", "remove", "radio-off", "break-motor", "slow")
+REACH_MARGIN = 1e-3  # m beyond the IR's reach within which another robot's circle is still ray-cast
 
 
 @dataclass
@@ -110,7 +111,8 @@ class KinematicTeam:
         origins, directions = body.rays()
         ranges = body.ranges(self.world, (origins, directions))
         cx, cy = body.centre(body.x, body.y, body.heading)
-        reach = body.robot.ir_range + float(body.sensor_radius.max())  # a circle beyond it cannot be seen
+        # A circle farther than any ray reaches cannot be seen; the margin covers circle_ranges' rounding
+        reach = body.robot.ir_range + float(body.sensor_radius.max()) + REACH_MARGIN
         others = [(centre, m.body.robot.radius) for other, m in self.members.items() if other != name and m.alive
                   for centre in [m.body.centre(m.body.x, m.body.y, m.body.heading)]
                   if math.dist(centre, (cx, cy)) - m.body.robot.radius <= reach]

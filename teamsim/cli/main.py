@@ -183,6 +183,8 @@ def _build_parser() -> argparse.ArgumentParser:
                                                                              "--full: 10)")
     feedback.add_argument("--densities", type=_csv_of("density", (5, 10, 15), int), default=(5, 10, 15),
                           help="obstacle densities in %% (default: 5,10,15)")
+    feedback.add_argument("--terrain", type=_csv_of("terrain", ("dry", "bog")), default=("dry", "bog"),
+                          help="worlds without bogs (dry), with about 5 %% bogs (bog), or both (default)")
     feedback.add_argument("--no-retune", action="store_true", help="tune at T_m 60 s only (skip re-running each "
                                                                    "level's best at 180 and 300 s)")
     feedback.add_argument("--ray", action="store_true", help="run the trials on a local Ray instance")
@@ -259,7 +261,7 @@ def _csv_of(name: str, allowed: tuple | None, kind=str):
     """An argparse type: a comma-separated list of ``kind`` values, each in ``allowed`` when given."""
     def parse(text: str) -> tuple:
         try:
-            values = tuple(kind(item.strip()) for item in text.split(",") if item.strip())
+            values = tuple(dict.fromkeys(kind(item.strip()) for item in text.split(",") if item.strip()))
         except ValueError:
             raise argparse.ArgumentTypeError(f"{name}s must be {kind.__name__}s separated by commas") from None
         bad = [v for v in values if allowed is not None and v not in allowed]
@@ -375,7 +377,8 @@ def cmd_study(args) -> int:
         full = args.full
         out = run_study(FeedbackStudy(levels=args.levels, worlds=args.worlds or (10 if full else 1),
                                       repeats=args.repeats or (10 if full else 1), seed=args.seed,
-                                      densities=tuple(d / 100 for d in args.densities), retune_t_m=not args.no_retune,
+                                      densities=tuple(d / 100 for d in args.densities),
+                                      bogs=tuple(t == "bog" for t in args.terrain), retune_t_m=not args.no_retune,
                                       workers=args.workers, ray=args.ray, duration=args.duration, out=args.out,
                                       resume=args.resume))
         print(f"wrote {out / 'report.md'}, {out / 'feedback.png'} and {out / 'results.csv'}")

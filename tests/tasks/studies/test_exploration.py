@@ -60,7 +60,9 @@ def test_a_small_study_writes_its_report_table_and_figure(tmp_path, capsys):
     assert len(rows) == 12 and {r["team"] for r in rows} == {"1 3", "1 5"}
     assert all(r["status"] == "failed" and float(r["exploration_time"]) == 20.0 for r in rows)  # cut at 20 s
     report = (out / "report.md").read_text()
-    assert "| [1 5] vs [1 3]: ET | x 0.763 |" in report and "Runs cut at 20 s" in report
+    et = next(line for line in report.splitlines() if line.startswith("| [1 5] vs [1 3]: ET |"))
+    assert "| x 1 (6 pairs) |" in et  # every run cut at 20 s: the same ET
+    assert "Runs cut at 20 s" in report and "explores at most about 80 %" not in report  # no MET claim when cut
     assert all((out / f"exploration.{kind}").stat().st_size > 0 for kind in ("png", "svg"))
 
 

@@ -73,7 +73,7 @@ def _studies():
             worlds=1, teams=("1 3",), densities=(0.05,), duration=SHORT_S, workers=1, out=out, resume=resume)),
             (sweep, "_run_one"), _short, (exploration,)),
         "feedback": (lambda out, resume: feedback.run_study(feedback.FeedbackStudy(
-            levels=("complete",), densities=(0.05,), bogs=(False,), duration=SHORT_S, retune_t_m=False, workers=1,
+            levels=("task-score",), densities=(0.05,), bogs=(False,), duration=SHORT_S, retune_t_m=False, workers=1,
             out=out, resume=resume)), (sweep, "_run_one"), _short, (feedback,)),
         "formation": (lambda out, resume: formation.run_study(formation.FormationStudy(
             runs=2, strategies=("I", "IV"), duration=SHORT_S, workers=1, out=out, resume=resume)),
