@@ -12,10 +12,10 @@ paired two-sided t-tests are the thesis's. The levels, in the order of §8.2's t
 - ``complete`` (3.3): a forced complete failure (an explorer silenced for good), the best of 3.1 and 3.2;
 - ``combined`` (3.4): every component at its best, no forced failure, all teams.
 
-Tuning is at T_m = 60 s; the best variant of each level (per team, highest mean ER) is then re-run at 180 and 300
-s. A level not run leaves the thesis's best (W3, P1, F2). The failing explorer and the failure time come from the
-study seed, the world and the repeat, never a planner (docs/decisions.md, "The chapter 8 studies"): the same with and
-without feedback.
+Tuning is at T_m = 60 s; the best variant of each level (per team, the highest ER against no feedback) is then
+re-run at 180 and 300 s, against no feedback at the same T_m. A level not run leaves the thesis's best (W3, P1, F2).
+The failing explorer and the failure time come from the study seed, the world and the repeat, never a planner
+(docs/decisions.md, "The chapter 8 studies"): the same with and without feedback.
 """
 from __future__ import annotations
 
