@@ -62,13 +62,13 @@ EXPECTED_PER_MINUTE = {
 }
 PLANNER_PER_MINUTE = {"plan": [0.442, 0.442], "comm": [10380.0]}  # Robot4 on W1, Table 5.31
 MAPPING = MappingParams(hit_cell="beyond")  # cells occupied when their centre is, as the true raster counts
-# Table 8.1's levels: off (level 1), task scores only (level 2), the whole feedback coordination (level 3)
-FEEDBACK_MODES = ("on", "scores", "off")
+# Table 8.1's levels: none (level 1), task scores only (level 2), the whole feedback coordination (level 3)
+FEEDBACK_MODES = ("full", "scores", "none")  # not on/off: YAML would read those as booleans
 # The explorers' feedback settings Table 8.1 varies; "table" keeps thesis_tasks.toml's (Table 5.29's)
 WEIGHT_SETS = {"W1": (0.0, 0.0, 0.5, 0.5), "W2": (0.1, 0.1, 0.4, 0.4), "W3": (0.2, 0.2, 0.3, 0.3),
                "W4": (0.25, 0.25, 0.25, 0.25)}  # WS over [plan, comm, sense, act]
-POOR_THRESHOLDS = {"off": -1.0, "P1": 0.75, "P2": 0.65, "P3": 0.55, "P4": 0.45}  # OTES_T (5.20)
-PARTIAL_THRESHOLDS = {"off": -1.0, "F1": 0.05, "F2": 0.15, "F3": 0.2, "F4": 0.25}  # TES_T (5.19)
+POOR_THRESHOLDS = {"none": -1.0, "P1": 0.75, "P2": 0.65, "P3": 0.55, "P4": 0.45}  # OTES_T (5.20)
+PARTIAL_THRESHOLDS = {"none": -1.0, "F1": 0.05, "F2": 0.15, "F3": 0.2, "F4": 0.25}  # TES_T (5.19)
 TEAM_FORM = re.compile(r"^\[?\s*(\d+)[\s,]+(\d+)\s*\]?$")
 
 
@@ -86,8 +86,8 @@ class ExploreParams:
     world_seed: int = setting(-1, lo=-1, hi=2**31 - 1, meaning="world layout seed (-1: the trial seed)")
     backend: str = setting("physics", choices=("physics", "kinematic"),
                            meaning="physics (MuJoCo) or kinematic (no contacts, for studies)")
-    feedback: str = setting("on", choices=FEEDBACK_MODES, meaning="on: the ch.5 feedback coordination every T_m; "
-                            "scores: task scores only, no reallocation (Table 8.1 level 2); off: none (level 1)")
+    feedback: str = setting("full", choices=FEEDBACK_MODES, meaning="full: the ch.5 feedback coordination every T_m; "
+                            "scores: task scores only, no reallocation (Table 8.1 level 2); none: no feedback (level 1)")
     weights: str = setting("table", choices=("table", *WEIGHT_SETS), meaning="the explorers' WS (Table 8.1)")
     poor: str = setting("table", choices=("table", *POOR_THRESHOLDS), meaning="the explorers' OTES_T (Table 8.1)")
     partial: str = setting("table", choices=("table", *PARTIAL_THRESHOLDS),
@@ -126,7 +126,7 @@ class ExploreTask:
     t_m: float = setting(60.0, lo=1.0, hi=3600.0, meaning="feedback period T_m, s")
     explored_threshold: float = setting(EXPLORED_THRESHOLD, lo=0.0, hi=1.0, meaning="EA_T of (6.18)")
     backend: str = setting("physics", choices=("physics", "kinematic"), meaning="physics or kinematic")
-    feedback: str = setting("on", choices=FEEDBACK_MODES, meaning="on, scores (no reallocation) or off")
+    feedback: str = setting("full", choices=FEEDBACK_MODES, meaning="full, scores (no reallocation) or none")
     weights: str = setting("table", choices=("table", *WEIGHT_SETS), meaning="the explorers' WS")
     poor: str = setting("table", choices=("table", *POOR_THRESHOLDS), meaning="the explorers' OTES_T")
     partial: str = setting("table", choices=("table", *PARTIAL_THRESHOLDS), meaning="the explorers' TES_T")
@@ -365,8 +365,8 @@ def team_controller(name: str, robot: RobotModel, info: dict) -> TeamRobot:
     if name == m2:
         coordinator = FeedbackCoordinator(allocation, expected_achievement(specs, task.t_m),
                                           feedback={EXPLORER: explorer_feedback(allocation, task)},
-                                          detect_failures=task.feedback == "on")
-        feedback = FeedbackSystem(name, coordinator, task.t_m, enabled=task.feedback != "off")
+                                          detect_failures=task.feedback == "full")
+        feedback = FeedbackSystem(name, coordinator, task.t_m, enabled=task.feedback != "none")
         info["team"]["feedback"] = feedback
     spec = specs[name]
     offset = centre_offset(robot)

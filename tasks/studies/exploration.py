@@ -89,7 +89,7 @@ def explore_config(study, team: str, run: tuple, label: str, faults=(), backend:
 
 
 def trial_configs(study: ExplorationStudy) -> list[TrialConfig]:
-    return [explore_config(study, team, run, "", backend=study.backend, feedback="off") for run in runs(study)
+    return [explore_config(study, team, run, "", backend=study.backend, feedback="none") for run in runs(study)
             for team in study.teams]
 
 

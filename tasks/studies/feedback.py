@@ -55,11 +55,11 @@ class Level:
 LEVELS = {level.name: level for level in (
     Level("task-score", "task-score feedback (level 2)", ("1 3", "1 5"), "none", "scores", "weights",
           ("W1", "W2", "W3", "W4")),
-    Level("poor", "poor-performance feedback (level 3.1)", TEAMS, "none", "on", "poor", ("P1", "P2", "P3", "P4")),
-    Level("partial", "partial-failure feedback (level 3.2)", ("1 3", "1 5"), "partial", "on", "partial",
+    Level("poor", "poor-performance feedback (level 3.1)", TEAMS, "none", "full", "poor", ("P1", "P2", "P3", "P4")),
+    Level("partial", "partial-failure feedback (level 3.2)", ("1 3", "1 5"), "partial", "full", "partial",
           ("F1", "F2", "F3", "F4")),
-    Level("complete", "complete-failure feedback (level 3.3)", ("1 3", "1 5"), "complete", "on", None, ("best",)),
-    Level("combined", "combined feedback (level 3.4)", TEAMS, "none", "on", None, ("best",)),
+    Level("complete", "complete-failure feedback (level 3.3)", ("1 3", "1 5"), "complete", "full", None, ("best",)),
+    Level("combined", "combined feedback (level 3.4)", TEAMS, "none", "full", None, ("best",)),
 )}
 THESIS_BEST = {"weights": "W3", "poor": "P1", "partial": "F2"}  # §8.4-8.5
 T_M = (60.0, 180.0, 300.0)
@@ -133,7 +133,7 @@ def settings_of(level: Level, variant: str, best: dict) -> dict:
     found so far for the team (``best``: setting -> value)."""
     chosen = {"weights": best["weights"], "poor": best["poor"], "partial": best["partial"]}
     if level.name == "task-score":
-        chosen.update(poor="off", partial="off")
+        chosen.update(poor="none", partial="none")
     if level.tuned is not None:
         chosen[level.tuned] = variant
     if level.name == "poor":
@@ -150,7 +150,7 @@ def baseline_configs(study: FeedbackStudy, levels, t_m: float) -> list[tuple]:
     for team, failure in wanted:
         for run in runs(study):
             fault = forced_fault(study, team, run, failure)
-            config = explore_config(study, team, run, f"baseline-{failure}-{t_m:g}_", feedback="off", t_m=t_m,
+            config = explore_config(study, team, run, f"baseline-{failure}-{t_m:g}_", feedback="none", t_m=t_m,
                                     faults=[parse_fault(fault)] if fault else [])
             planned.append((config, {"level": "baseline", "variant": "-", "t_m": t_m, "failure": failure}))
     return planned

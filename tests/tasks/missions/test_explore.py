@@ -91,7 +91,7 @@ def test_a_broken_motor_is_a_partial_failure():
     assert events(run, "explorer removed")[0]["robot"] == flags[0]["robot"]
 
 
-@pytest.mark.parametrize("feedback", ["off", "scores"])
+@pytest.mark.parametrize("feedback", ["none", "scores"])
 def test_without_the_feedback_coordination_a_broken_explorer_keeps_its_role(feedback):
     """Table 8.1 levels 1 and 2: nobody flags the explorer whose motor broke, so nothing is reallocated (with
     feedback on, the same fault is a partial failure: the test above)."""
@@ -109,7 +109,7 @@ def test_table_8_1_settings_replace_the_explorers_weights_and_thresholds():
     assert explorer_feedback(allocation, ExploreTask()) == table
     chosen = explorer_feedback(allocation, ExploreTask(weights="W3", poor="P1", partial="F2"))
     assert (chosen.ws, chosen.otes_threshold, chosen.tes_threshold) == ((0.2, 0.2, 0.3, 0.3), 0.75, 0.15)
-    assert explorer_feedback(allocation, ExploreTask(poor="off")).otes_threshold == -1
+    assert explorer_feedback(allocation, ExploreTask(poor="none")).otes_threshold == -1
 
 
 def test_a_wheeled_explorer_backs_out_of_a_bog_and_a_tracked_one_maps_it():

@@ -17,7 +17,7 @@ def test_every_team_runs_the_same_worlds_and_seeds_and_each_environment_type_its
     by_run = {}
     for c in configs:
         p = c.params
-        assert p.backend == "kinematic" and p.feedback == "off"
+        assert p.backend == "kinematic" and p.feedback == "none"
         assert p.bog_share == (0.05 if "_bog_" in c.run_id else 0.0)
         by_run.setdefault(c.run_id.split("_", 1)[1], set()).add((p.world_seed, c.seed, p.density, p.bog_share))
     assert len(by_run) == 3 * 2 * 2 * 2 and all(len(v) == 1 for v in by_run.values())  # one world per pair key

@@ -18,7 +18,7 @@ from teamsim.tasks.studies.feedback import (LEVELS, THESIS_BEST, FeedbackStudy, 
 
 def test_each_level_tunes_its_own_setting_and_keeps_the_best_of_the_levels_before():
     best = {"weights": "W2", "poor": "P3", "partial": "F4"}
-    assert settings_of(LEVELS["task-score"], "W1", best) == {"weights": "W1", "poor": "off", "partial": "off"}
+    assert settings_of(LEVELS["task-score"], "W1", best) == {"weights": "W1", "poor": "none", "partial": "none"}
     assert settings_of(LEVELS["poor"], "P4", best) == {"weights": "W2", "poor": "P4", "partial": "F2"}  # TES_T 0.15
     assert settings_of(LEVELS["partial"], "F1", best) == {"weights": "W2", "poor": "P3", "partial": "F1"}
     assert settings_of(LEVELS["combined"], "best", best) == best
@@ -33,7 +33,7 @@ def test_a_forced_failure_strikes_an_explorer_that_is_not_the_planner_the_same_w
                for f in faults)
     baselines = {c.run_id.split("_", 1)[1]: c.faults for c, _ in baseline_configs(study, ["partial"], 60.0)}
     tuned = level_configs(study, LEVELS["partial"], {t: dict(THESIS_BEST) for t in ("1 3", "1 5")}, 60.0)
-    assert {c.params.feedback for c, _ in tuned} == {"on"}
+    assert {c.params.feedback for c, _ in tuned} == {"full"}
     assert {meaning["failure"] for _, meaning in tuned} == {"partial"}
     for config, _ in tuned:
         assert config.faults == baselines[config.run_id.split("_", 1)[1]] and config.faults[0].kind == "break-motor"
