@@ -86,8 +86,9 @@ class ExploreParams:
     world_seed: int = setting(-1, lo=-1, hi=2**31 - 1, meaning="world layout seed (-1: the trial seed)")
     backend: str = setting("physics", choices=("physics", "kinematic"),
                            meaning="physics (MuJoCo) or kinematic (no contacts, for studies)")
-    feedback: str = setting("full", choices=FEEDBACK_MODES, meaning="full: the ch.5 feedback coordination every T_m; "
-                            "scores: task scores only, no reallocation (Table 8.1 level 2); none: no feedback (level 1)")
+    feedback: str = setting("full", choices=FEEDBACK_MODES,
+                            meaning="full: the ch.5 feedback coordination every T_m; scores: task scores only, no "
+                                    "reallocation (Table 8.1 level 2); none: no feedback (level 1)")
     weights: str = setting("table", choices=("table", *WEIGHT_SETS), meaning="the explorers' WS (Table 8.1)")
     poor: str = setting("table", choices=("table", *POOR_THRESHOLDS), meaning="the explorers' OTES_T (Table 8.1)")
     partial: str = setting("table", choices=("table", *PARTIAL_THRESHOLDS),

@@ -13,7 +13,8 @@ DT = 0.1
 
 def robot(**learning) -> LearnedAcquiescence:
     core = AllianceRobot("green", [BehaviourSet("move-spill", rates=RATES)])
-    return LearnedAcquiescence(core, ("move-spill",), LearningParams(**{"min_lambda": 0.0, "enabled": True, **learning}))
+    params = LearningParams(**{"min_lambda": 0.0, "enabled": True, **learning})
+    return LearnedAcquiescence(core, ("move-spill",), params)
 
 
 def activations(selector: LearnedAcquiescence, until: float, done_after: float | None = None, time: float = 0.0):
@@ -78,7 +79,8 @@ def test_a_success_after_failures_restores_the_fast_rate():
     activations(selector, 15.0)  # one failure at lambda = 10 s, attributed 20 s
     assert selector.failed_last["move-spill"]
     assert selector.rates()["move-spill"].delta_fast == pytest.approx(1 / 20, rel=0.02)
-    assert selector.rates()["move-spill"].slow_rate("red") <= selector.rates()["move-spill"].delta_fast  # delta_slow never above delta_fast
+    rates = selector.rates()["move-spill"]
+    assert rates.slow_rate("red") <= rates.delta_fast  # delta_slow never above delta_fast
     spans = activations(selector, 120.0, done_after=5.0, time=15.0)  # the fix: now it succeeds
     assert not selector.failed_last["move-spill"]
     assert selector.rates()["move-spill"].delta_fast == RATES.delta_fast
