@@ -152,9 +152,10 @@ class GlobalInfo:
             requeued = self.queue.requeue_planner(planner)
             self.busy.discard(planner)
             self.log.append({"t": now, "event": "planner removed", "robot": planner, "requeued": len(requeued)})
+        newcomers = set(workers.get(EXPLORER, [])) - set(self.explorers)
         self.explorers = list(workers.get(EXPLORER, []))
         self.planners = list(workers.get(PLANNER, []))
-        self.finished -= set(self.explorers)
+        self.finished -= newcomers  # an explorer that kept its role and had finished stays finished
 
     # -- the environments ---------------------------------------------------------------------------------------
     def _integrate(self, environment: int) -> str:

@@ -1,0 +1,25 @@
+"""The manager's reaction to new roles (Chand §6.4, Fig 6.9): an explorer that keeps its role after a reallocation
+keeps its state, so a team whose explorers had all finished is still done."""
+from __future__ import annotations
+
+from teamsim.controllers.exploration.manager import EXPLORER, PLANNER, GlobalInfo
+from teamsim.controllers.exploration.territory import Territory
+
+
+def manager(explorers: list[str]) -> GlobalInfo:
+    return GlobalInfo("Robot3", Territory(19.2, 0.3, 2), explorers=explorers, planners=["Robot4"],
+                      task_scores={EXPLORER: {e: 1.0 for e in explorers}, PLANNER: {"Robot4": 1.0}},
+                      bog_capable={}, radii={}, rates={}, t_m=60.0)
+
+
+def test_a_reallocation_keeps_finished_explorers_finished_and_starts_newcomers_afresh():
+    info = manager(["Robot4", "Robot2", "Robot5"])
+    info.finished = {"Robot4", "Robot2", "Robot5"}
+    info.receive("Robot1", "roles", {"workers": {EXPLORER: ["Robot4", "Robot2", "Robot5"], PLANNER: ["Robot4"]}},
+                 100.0)
+    assert info.finished == {"Robot4", "Robot2", "Robot5"}  # the same explorers: still done
+    info.receive("Robot1", "roles", {"workers": {EXPLORER: ["Robot4", "Robot2", "Robot7"], PLANNER: ["Robot4"]}},
+                 160.0)
+    assert info.explorers == ["Robot4", "Robot2", "Robot7"]
+    assert info.finished & set(info.explorers) == {"Robot4", "Robot2"}  # Robot7 is new to the role: not done
+    assert [e["robot"] for e in info.log if e["event"] == "explorer removed"] == ["Robot5"]
