@@ -113,14 +113,19 @@ class KinematicTeam:
         cx, cy = body.centre(body.x, body.y, body.heading)
         # A circle farther than any ray reaches cannot be seen; the margin covers circle_ranges' rounding
         reach = body.robot.ir_range + float(body.sensor_radius.max()) + REACH_MARGIN
-        others = [(centre, m.body.robot.radius) for other, m in self.members.items() if other != name and m.alive
-                  for centre in [m.body.centre(m.body.x, m.body.y, m.body.heading)]
-                  if math.dist(centre, (cx, cy)) - m.body.robot.radius <= reach]
-        if not others:
+        centres, radii = [], []
+        for other, member in self.members.items():
+            if other == name or not member.alive:
+                continue
+            them = member.body
+            centre = them.centre(them.x, them.y, them.heading)
+            if math.dist(centre, (cx, cy)) - them.robot.radius <= reach:
+                centres.append(centre)
+                radii.append(them.robot.radius)
+        if not centres:
             return ranges
-        centres = np.array([centre for centre, _ in others])
-        radii = np.array([radius for _, radius in others])
-        return np.minimum(ranges, circle_ranges(origins, directions, centres, radii, body.robot.ir_range))
+        return np.minimum(ranges, circle_ranges(origins, directions, np.array(centres), np.array(radii),
+                                                body.robot.ir_range))
 
     def _bumps(self, name: str, body: KinematicBody, x: float, y: float, heading: float) -> bool:
         """The move would bring its enclosing circle closer into another live robot's."""
