@@ -67,6 +67,7 @@ class Robot:
     geoms: np.ndarray = None
     beam_adr: np.ndarray = None
     effectors: dict = field(default_factory=dict)  # name -> (actuator ids, joint qpos address)
+    _blind: tuple | None = field(default=None, repr=False)  # (health.ir_blind, its mask over the IR sensors)
 
     @property
     def name(self) -> str:
@@ -78,7 +79,10 @@ class Robot:
 
     def ir_blind_mask(self) -> np.ndarray:
         prefixes = self.health.ir_blind
-        return np.array([any(name.startswith(p) for p in prefixes) for name in self.model.ir_sensors], bool)
+        if self._blind is None or self._blind[0] != prefixes:  # read every tick, changed only by a fault
+            mask = np.array([any(name.startswith(p) for p in prefixes) for name in self.model.ir_sensors], bool)
+            self._blind = (prefixes, mask)
+        return self._blind[1]
 
 
 def bog_drag(robot: RobotModel) -> float:

@@ -292,7 +292,9 @@ class FormationMission(ScenarioMission):
         last = info["sensed"].get(name)
         if last is not None and world.time < last[0] + cfg.period - 1e-9:
             return {SIGNAL: last[1]}
-        rng = info["sense_rng"].setdefault(name, world.streams.get("robot", name, "formation"))
+        if name not in info["sense_rng"]:  # (setdefault would build a generator every call)
+            info["sense_rng"][name] = world.streams.get("robot", name, "formation")
+        rng = info["sense_rng"][name]
         me = world.robots[name]
         x, y, yaw = world.pose(me)
         c, s = math.cos(yaw), math.sin(yaw)

@@ -223,7 +223,9 @@ class JanitorialMission(ScenarioMission):
         if "emptier" not in robot.model.effectors:
             return {}
         info, task = world.scene.info, world.scene.scenario.task
-        rng = info["sound"].setdefault(name, world.streams.get("robot", name, "sound"))
+        if name not in info["sound"]:  # (setdefault would build a generator every call)
+            info["sound"][name] = world.streams.get("robot", name, "sound")
+        rng = info["sound"][name]
         x, y, yaw = world.pose(robot)
         angles = np.array([yaw + math.pi / 4, yaw - math.pi / 4])  # left, right
         axes = np.stack([np.cos(angles), np.sin(angles)], axis=1)
