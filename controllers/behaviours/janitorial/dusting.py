@@ -89,6 +89,7 @@ class DustFurniture:
         self.finished: list[np.ndarray] = []  # objects this robot dusted (their centroids)
         self.verified: list[np.ndarray] = []  # dusted objects it went back to and circled again
         self._verifying = False
+        self.verify_at: np.ndarray | None = None
         self.tall: list[np.ndarray] = []  # sightings the upper ring saw too, close up: not dustable
         self._candidate: tuple[np.ndarray, int] | None = None  # a sighting and how many periods running
         self._state = "search"
@@ -105,6 +106,7 @@ class DustFurniture:
     def start(self, _instance: str, time: float, verify_at: np.ndarray | None = None) -> None:
         """Search for an object to dust; or, ``verify_at``, go back to a dusted one and circle it again."""
         self._state, self.target, self._verifying = "search", None, verify_at is not None
+        self.verify_at = verify_at  # the dusted object this verification goes back to, kept once it is circled
         if verify_at is not None:
             self._state, self._since, self.target, self._sighted = "approach", time, verify_at, verify_at
 
@@ -126,7 +128,7 @@ class DustFurniture:
                 self._state, self._since, self._hits, self._swept, self._last_angle = "circle", obs.time, [], 0.0, None
             elif obs.time - self._since > p.approach_timeout * (3 if self._verifying else 1):
                 if self._verifying:  # could not get back to it: verified as far as it can be
-                    self.verified.append(self.target.copy())
+                    self.verified.append(self.verify_at.copy())
                 self._state = "search"
                 return Command(extras={"duster": 0.0})
             else:
@@ -148,7 +150,10 @@ class DustFurniture:
             self._last_angle = angle
         if (self._swept >= p.circle_turn and self._seen_round() >= p.seen_sectors) or \
                 obs.time - self._since > p.circle_timeout:
-            (self.verified if self._verifying else self.finished).append(self.target.copy())
+            if self._verifying:
+                self.verified.append(self.verify_at.copy())  # as it was announced, so teammates match it
+            else:
+                self.finished.append(self.target.copy())
             self._state, self.target = "search", None
             return Command(extras={"duster": 0.0})
         v, omega = self.follow(ranges)

@@ -112,3 +112,57 @@ def test_janitor_carries_the_tools_of_its_tasks_only():
     assert sum(n.startswith("low") for n in r1.ir_sensors) == sum(n.startswith("ir") for n in r1.ir_sensors) == 12
     with pytest.raises(ValueError, match="unknown task 'mop'"):
         build_robot("janitor", "r9", tools=("mop",))
+
+
+def _observation(robot, time: float):
+    from teamsim.controllers.base import Observation
+    from teamsim.positioning import PoseFix
+
+    n = len(robot.ir_sensors)
+    wheels = len(robot.drive.left) + len(robot.drive.right)
+    return Observation(time=time, robot=robot.name, ir_raw=np.zeros(n), ir_range=np.full(n, np.inf),
+                       ir_bearings=robot.ir_bearings, pose=PoseFix(0.0, 0.0, 0.0, time), motor_speeds=np.zeros(wheels),
+                       velocity=(0.0, 0.0))
+
+
+@pytest.mark.parametrize("verify", ["floor", "dust"])
+def test_a_verification_set_goes_on_to_the_next_quadrant_or_object_once_one_is_verified(verify):
+    """verify-floor and verify-dusting stay applicable while anything is unverified: after verifying one quadrant
+    (object) the robot starts the next. (Started only on activation, a robot that had verified one quadrant stood
+    still until lambda, 600 s, and the floor stayed at 92 %: seed 101.)"""
+    from teamsim.controllers.behaviours.janitorial.floor import QUADRANTS
+    from teamsim.controllers.behaviours.janitorial.robot import VERIFY_DUST, VERIFY_FLOOR, JanitorRobot
+
+    tools = ("dust-furniture", "clean-floor")
+    robot = build_robot("janitor", "r3", tools=tools)
+    brain = JanitorRobot(robot, tools, ("f1",), 2, np.random.default_rng(0))
+    brain.floor.bounds = (-1.0, 1.0, -1.0, 1.0)
+    brain.floor.grid = CoverageGrid(brain.floor.bounds, 0.4)
+    objects = [np.array([0.5, 0.5]), np.array([-0.5, -0.5])]
+    for at in objects:
+        brain.claims.completed(at)
+    wanted = VERIFY_FLOOR if verify == "floor" else VERIFY_DUST
+    if verify == "floor":
+        brain.quadrants_done = set(QUADRANTS)
+        brain.verified_dust = list(objects)  # (and no object to verify)
+    else:
+        brain.verified_floor = set(QUADRANTS)  # (and no quadrant to clean: every floor set inapplicable)
+        brain.quadrants_done = set(QUADRANTS)
+    t = 0.0
+    while brain.active != wanted:
+        brain(_observation(robot, t))
+        t = round(t + 0.1, 6)
+        assert t < 200.0, "the verification set never became active"
+    if verify == "floor":
+        first = brain.floor.quadrant
+        brain.floor.verified.append(first)  # as _cover records a quadrant covered again
+        brain(_observation(robot, t))
+        brain(_observation(robot, t + 0.1))
+        assert brain.active == VERIFY_FLOOR and brain.floor.quadrant not in {first, None}
+    else:
+        first = brain.dust.verify_at.copy()
+        brain.dust.verified.append(first)  # as _circle records an object circled again
+        brain(_observation(robot, t))
+        brain(_observation(robot, t + 0.1))
+        assert brain.active == VERIFY_DUST and brain.dust.verify_at is not None
+        assert np.hypot(*(brain.dust.verify_at - first)) > 0.5
