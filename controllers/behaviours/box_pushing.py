@@ -90,9 +90,6 @@ class BoxPushParams:
     end_overrun: float = 0.04  # m driven on after the side IR loses the face: the end is passed
     end_inset: float = 0.15  # m backed up from there: the robot pushes this far in from the end
     contact_range: float = 0.03  # m: a fingertip reading nearer than this is contact
-    # rad the push heading may move per push: the box turns 1-3 degrees a push, so a square push that reads more is
-    # square to something else (a dead teammate's flank set it 19 degrees off, kill:green@30.6 seed 45)
-    heading_step: float = 0.1
     approach_timeout: float = 4.0  # s closing in without contact: the box is not there, acquire the end again
     # misses in a row (an approach that met nothing, or an activation that ended without a push): the robot cannot
     # reach the box (a broken drive) and, while a teammate claims a task, withdraws from the pushes; it stops
@@ -352,12 +349,10 @@ class PushEnd:
         p = self.params
         if obs.time - self.mark[0] >= p.push_time:
             # Both fingertips at the face: square to it, its normal by the compass (the encoders slip while
-            # pushing), moved at most heading_step. Else it pushed a corner and turned with it: the heading it had
-            # stays (docs/decisions.md, "Box pushing: the push heading").
+            # pushing). Else it pushed a corner and turned with it: the heading it had stays (docs/decisions.md,
+            # "Box pushing: the push heading").
             if (obs.ir_range[self.tips] < p.contact_range).all():
-                turn = wrap_angle(float(obs.pose.heading) - self.station.heading)
-                self.station.heading = wrap_angle(self.station.heading + float(np.clip(turn, -p.heading_step,
-                                                                                        p.heading_step)))
+                self.station.heading = float(obs.pose.heading)
             return self._go("release", obs)
         return self.drive(p.push_speed, self.square(obs))
 
