@@ -42,6 +42,7 @@ GROUPS = ("A", "B")  # A bounds first (the thesis's "first team")
 JOIN, EMERGE, LEAD, FOLLOW, OVERWATCH = "join-group", "emerge-leader", "lead-to-waypoint", "follow-leader", "overwatch"
 SETS = (JOIN, EMERGE, LEAD, FOLLOW, OVERWATCH)  # priority order (the §3.6 tie-break)
 LONG = 1e6  # s: psi and lambda of sets that are never handed over or given up
+WAYPOINT = "waypoint"  # the leader's own entry in its approach stalls
 PROGRESS = 0.5  # m a stalled teammate must gain to be waited for again (Stalls, OverwatchParams.patience)
 
 
@@ -55,6 +56,9 @@ class OverwatchParams:
                                             "alone")
     arrive: float = setting(0.5, lo=0.05, hi=5.0, meaning="m from its waypoint at which a leader has arrived "
                                                           "(its bound is complete)")
+    blocked_radius: float = setting(2.0, lo=0.05, hi=50.0, meaning="m from its waypoint within which a leader that "
+                                    "gets no nearer (by 0.5 m) for patience s has arrived: something stands there "
+                                    "(half the default bound)")
     gather_radius: float = setting(1.5, lo=0.1, hi=10.0, meaning="m from its gathering point at which a robot has "
                                                                  "visited it (and stops, leaving room for others)")
     wedge_back: float = setting(1.6, lo=0.5, hi=10.0, meaning="m each row of the follow wedge lies behind the "
@@ -373,6 +377,7 @@ class OverwatchRobot:
         self.leaderships: list[Record] = []
         self.bound_log: list[Record] = []
         self.lagging = Stalls()  # followers beyond lag from their slots
+        self.approach = Stalls()  # the leader itself, near its waypoint
         self.arriving = Stalls()  # members not yet at the gathering point
         fast = {s: MotivationRates(delta_fast=1 / params.set_delay, delta_slow=1 / (10 * params.set_delay),
                                    phi=LONG, psi=LONG, lam=LONG) for s in SETS}
@@ -528,17 +533,29 @@ class OverwatchRobot:
             me.leading = bound
             self.bound_log.append(Record(self.group, self.name, obs.time, bound=bound))
             self.lagging.clear()  # each bound waits afresh for its laggards
+            self.approach.clear()
         target = np.array(self.route[bound])
         offset = target - self.pose[:2]
         distance = float(np.hypot(*offset))
-        if distance <= p.arrive:
+        lag = self._lag(obs.time)
+        slow = float(np.clip((2 * p.lag - lag) / p.lag, 0.0, 1.0))
+        if distance <= p.arrive or self._blocked(obs.time, distance, slow):
             self.bound_log[-1].end = obs.time
             self.k.bounds, me.leading = bound + 1, None
             return Command()
-        lag = self._lag(obs.time)
-        slow = float(np.clip((2 * p.lag - lag) / p.lag, 0.0, 1.0))
         v, w = self.drive(obs, self.pose, offset, p.lead_speed * slow * min(1.0, distance / 1.0 + 0.3))
         return Command(v=v, omega=w)
+
+    def _blocked(self, now: float, distance: float, slow: float) -> bool:
+        """Within ``blocked_radius`` of its waypoint and no nearer by PROGRESS for ``patience`` seconds, and not
+        held back for its followers now: something stands at the waypoint, and this is as near as the leader gets.
+        (The leader killed beside its waypoint, by the wall, kept the next one 1.0-1.8 m off it, pushed away by
+        the IR, for 830 s: kill:@leader@66.9, seed 41.)"""
+        p = self.params
+        if distance > p.blocked_radius:
+            self.approach.forget(WAYPOINT)
+            return False
+        return self.approach.stalled(WAYPOINT, now, distance, p.patience) and slow >= 1.0
 
     def _lag(self, now: float) -> float:
         """How far the farthest live follower the leader still waits for is from its wedge slot, by their

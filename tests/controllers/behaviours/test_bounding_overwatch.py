@@ -247,3 +247,21 @@ def test_a_robot_that_goes_nowhere_backs_off_turning_towards_its_goal():
     assert drive.escapes == 1
     free = np.full(10, math.inf)
     assert drive(obs(8.5, pose, ranges=free), pose, goal, 0.3)[0] > 0.0  # the escape is over
+
+
+def test_a_leader_held_off_its_waypoint_by_something_there_has_arrived_after_patience():
+    """Within blocked_radius (2 m) of its waypoint and gaining less than 0.5 m for patience (30 s), the leader is as
+    near as it gets (a dead leader lay beside the waypoint: seed 41). Held back for its followers it is not
+    blocked; farther off, or gaining ground, it drives on."""
+    p = OverwatchParams()
+    leader = robot("red")
+    near = p.blocked_radius - 0.05
+    assert not leader._blocked(0.0, near, 1.0)
+    assert not leader._blocked(p.patience - 1.0, near - 0.3, 1.0)  # (gained less than PROGRESS: still the clock)
+    assert not leader._blocked(p.patience + 1.0, near - 0.3, 0.5)  # held back for a follower
+    assert leader._blocked(p.patience + 1.0, near - 0.3, 1.0)
+    far = robot("blue")
+    assert not any(far._blocked(t, p.blocked_radius + 0.1, 1.0) for t in (0.0, 3 * p.patience))
+    gaining = robot("cyan")
+    assert not any(gaining._blocked(t, near - 0.6 * k, 1.0) for k, t in enumerate((0.0, p.patience / 2 + 1)))
+    assert not gaining._blocked(p.patience + 2.0, near - 0.6, 1.0)  # the clock restarted when it gained 0.6 m
