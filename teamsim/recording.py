@@ -77,17 +77,24 @@ class TrajectoryRecorder:
         self.qpos.append(qpos.copy())
         self.behaviours.append(list(behaviours))
 
+    @property
+    def frames(self) -> int:
+        """Frames captured whole (a Ctrl-C inside :meth:`capture` can leave one list a frame longer)."""
+        return min(len(self.times), len(self.qpos), len(self.behaviours))
+
     def behaviour_array(self) -> np.ndarray:
         """Behaviours as a (frames, robots) array of strings."""
-        return np.array(self.behaviours, dtype=str).reshape(len(self.times), len(self.robot_names))
+        n = self.frames
+        return np.array(self.behaviours[:n], dtype=str).reshape(n, len(self.robot_names))
 
     def save(self, path: Path, extra: dict[str, np.ndarray] | None = None) -> None:
         """Write the frames, and ``extra`` arrays under their own names (the motivation series)."""
+        n = self.frames
         buffer = io.BytesIO()
         np.savez_compressed(
             buffer, model_xml=np.array(self.xml), robot_names=np.array(self.robot_names), fps=np.array(self.fps),
             speedup=np.array(self.speedup),
-            time=np.array(self.times), qpos=np.array(self.qpos).reshape(len(self.times), -1),
+            time=np.array(self.times[:n]), qpos=np.array(self.qpos[:n]).reshape(n, -1),
             behaviour=self.behaviour_array(), **(extra or {}))
         write_atomic(path, buffer.getvalue())
 
@@ -105,15 +112,22 @@ class MotivationSeries:
     active: array = field(default_factory=lambda: array("i"))
     events: list[tuple[float, int, str, str]] = field(default_factory=list)
 
+    @property
+    def ticks(self) -> int:
+        """Ticks recorded whole (a Ctrl-C inside the recorder can leave one array a tick longer)."""
+        return min(len(self.times), len(self.levels) // max(len(self.sets), 1), len(self.active))
+
     def level_array(self) -> np.ndarray:
-        return np.frombuffer(self.levels, dtype=float).reshape(len(self.times), len(self.sets))
+        n = self.ticks
+        return np.frombuffer(self.levels, dtype=float)[:n * len(self.sets)].reshape(n, len(self.sets))
 
     def arrays(self, prefix: str) -> dict[str, np.ndarray]:
         """The series as named arrays for ``trajectory.npz``, each name starting with ``prefix``."""
         times, sets, kinds, details = zip(*self.events) if self.events else ((), (), (), ())
+        n = self.ticks
         return {f"{prefix}sets": np.array(self.sets, dtype=str), f"{prefix}threshold": np.array(self.threshold),
-                f"{prefix}time": np.array(self.times), f"{prefix}m": self.level_array(),
-                f"{prefix}active": np.array(self.active), f"{prefix}event_time": np.array(times, dtype=float),
+                f"{prefix}time": np.array(self.times[:n]), f"{prefix}m": self.level_array(),
+                f"{prefix}active": np.array(self.active[:n]), f"{prefix}event_time": np.array(times, dtype=float),
                 f"{prefix}event_set": np.array(sets, dtype=int), f"{prefix}event_kind": np.array(kinds, dtype=str),
                 f"{prefix}event_detail": np.array(details, dtype=str)}
 

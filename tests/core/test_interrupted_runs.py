@@ -89,3 +89,29 @@ def test_a_write_that_fails_mid_run_is_one_line_exit_2_and_keeps_what_was_writte
     assert summary["status"] == "error" and "No space left on device" in summary["error"]
     assert {"trajectory.npz", "timeline.png"} <= set(summary["outputs"])
     assert (run_dir / "events.jsonl").read_text().count("\n") == 40  # the events before the disk filled
+
+
+def test_a_capture_torn_by_ctrl_c_still_saves_the_whole_frames_and_ticks(tmp_path):
+    """A SIGINT between the appends of a frame (or of a motivation tick) left one list a record longer, and saving
+    the interrupted run's trajectory raised ("cannot reshape array of size 1200 into shape (401,3)", seen in CI):
+    the run lost its trajectory. The torn record is dropped."""
+    import numpy as np
+
+    from teamsim.recording import MotivationSeries, TrajectoryRecorder, load_trajectory
+
+    recorder = TrajectoryRecorder("<mujoco/>", ["a", "b"], fps=10, physics_dt=0.01)
+    for k in range(3):
+        recorder.capture(0.1 * k, np.zeros(4), ["idle", "idle"])
+    recorder.times.append(0.3)  # interrupted here: no qpos, no behaviours for this frame
+    series = MotivationSeries(("s1", "s2"), 1.0)
+    for k in range(3):
+        series.times.append(0.1 * k)
+        series.levels.extend((0.0, 0.5))
+        series.active.append(-1)
+    series.times.append(0.3)
+    series.levels.extend((0.0,))  # interrupted half-way through a tick's levels
+    recorder.save(tmp_path / "trajectory.npz", series.arrays("motivation/a/"))
+    saved = load_trajectory(tmp_path / "trajectory.npz")
+    assert saved["time"].shape == (3,) and saved["qpos"].shape == (3, 4) and saved["behaviour"].shape == (3, 2)
+    assert saved["motivation/a/time"].shape == (3,) and saved["motivation/a/m"].shape == (3, 2)
+    assert saved["motivation/a/active"].shape == (3,)
