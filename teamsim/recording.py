@@ -117,17 +117,20 @@ class MotivationSeries:
         """Ticks recorded whole (a Ctrl-C inside the recorder can leave one array a tick longer)."""
         return min(len(self.times), len(self.levels) // max(len(self.sets), 1), len(self.active))
 
-    def level_array(self) -> np.ndarray:
+    def columns(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The whole ticks' (times, levels (ticks x sets), active set indices)."""
         n = self.ticks
-        return np.frombuffer(self.levels, dtype=float)[:n * len(self.sets)].reshape(n, len(self.sets))
+        return (np.frombuffer(self.times, dtype=float)[:n],
+                np.frombuffer(self.levels, dtype=float)[:n * len(self.sets)].reshape(n, len(self.sets)),
+                np.frombuffer(self.active, dtype=np.int32)[:n])
 
     def arrays(self, prefix: str) -> dict[str, np.ndarray]:
         """The series as named arrays for ``trajectory.npz``, each name starting with ``prefix``."""
         times, sets, kinds, details = zip(*self.events) if self.events else ((), (), (), ())
-        n = self.ticks
+        tick_times, levels, active = self.columns()
         return {f"{prefix}sets": np.array(self.sets, dtype=str), f"{prefix}threshold": np.array(self.threshold),
-                f"{prefix}time": np.array(self.times[:n]), f"{prefix}m": self.level_array(),
-                f"{prefix}active": np.array(self.active[:n]), f"{prefix}event_time": np.array(times, dtype=float),
+                f"{prefix}time": tick_times.copy(), f"{prefix}m": levels.copy(),
+                f"{prefix}active": active.copy(), f"{prefix}event_time": np.array(times, dtype=float),
                 f"{prefix}event_set": np.array(sets, dtype=int), f"{prefix}event_kind": np.array(kinds, dtype=str),
                 f"{prefix}event_detail": np.array(details, dtype=str)}
 

@@ -103,10 +103,7 @@ def draw_timeline(times: np.ndarray, behaviours: np.ndarray, robot_names: list[s
 
 def _draw_sets(axes, robot: str, series: MotivationSeries, top: float, end: float, colours: dict) -> None:
     """One robot's behaviour-set rows: active bars, theta, m(t) and the events."""
-    n = series.ticks
-    times = np.frombuffer(series.times, dtype=float)[:n]
-    levels = series.level_array()
-    active = np.frombuffer(series.active, dtype=np.int32)[:n]
+    times, levels, active = series.columns()
     span = 1 - 2 * MARGIN
 
     def y_of(row: int, m):
