@@ -110,6 +110,33 @@ def test_censored_runs_have_no_time_and_make_means_biased_or_undecided(tmp_path)
     assert "| 3 |" in step_2 and step_2.endswith("| too few completed runs to decide |")
 
 
+def test_report_says_where_the_teams_time_went(tmp_path):
+    """Each run's robot-seconds summed by task family over the robots and every instance; per rate the median and
+    the paired p against rho = 0. Here messages halve the dusting and turn the time saved into verification."""
+    study = jr.JanitorialRhoStudy(missions=10, out=tmp_path, duration=1500.0)
+    configs = jr.trial_configs(study)
+    summaries = []
+    for config in configs:
+        k, talking = config.seed, config.params.rho > 0
+        run = summary(k, 900.0)
+        run["metrics"]["task_time_s"] = {
+            "r1": {"empty-garbage f1": 40.0, "empty-garbage f2": 10.0 + k, "dust-furniture": (300.0 if talking
+                                                                                             else 600.0) + k},
+            "r2": {"clean-floor lower-left": 200.0, "clean-floor upper-right": 100.0, "idle": 5.0},
+            "r3": {"dust-furniture": 100.0, "verify-dusting": (400.0 if talking else 100.0) + k,
+                   "verify-floor": 50.0}}
+        summaries.append(run)
+    text = (jr.write_results(study, configs, summaries) / "report.md").read_text()
+    with open(tmp_path / "results.csv", newline="") as handle:
+        first = next(csv.DictReader(handle))
+    assert (first["empty_garbage_s"], first["dust_furniture_s"], first["clean_floor_s"], first["verification_s"],
+            first["idle_s"]) == ("50.0", "700.0", "300.0", "150.0", "5.0")
+    assert "| rho | empty garbage | dust furniture | clean floor | verification | idle |" in text
+    assert "| 0 | 54 | 704 | 300 | 154 | 5 |" in text  # medians over seeds 0..9: k = 4.5
+    # every seed's dusting 300 s less and verification 300 s more at each rate: p = 2 / 2**10; the rest equal: 1
+    assert "| 0.5 | 54 (p 1) | 404 (p 0.002) | 300 (p 1) | 454 (p 0.002) | 5 (p 1) |" in text
+
+
 def test_wilcoxon_p_is_exact_and_safe():
     assert jr.wilcoxon_p([1.0, 2.0, 3.0, 4.0, 5.0], [2.0, 3.0, 4.0, 5.0, 6.0]) == 0.0625  # 2 / 2**5
     assert jr.wilcoxon_p([1.0, 2.0], [1.0, 2.0]) == 1.0
