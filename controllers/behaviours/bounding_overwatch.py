@@ -42,7 +42,8 @@ GROUPS = ("A", "B")  # A bounds first (the thesis's "first team")
 JOIN, EMERGE, LEAD, FOLLOW, OVERWATCH = "join-group", "emerge-leader", "lead-to-waypoint", "follow-leader", "overwatch"
 SETS = (JOIN, EMERGE, LEAD, FOLLOW, OVERWATCH)  # priority order (the §3.6 tie-break)
 LONG = 1e6  # s: psi and lambda of sets that are never handed over or given up
-WAYPOINT = "waypoint"  # the leader's own entry in its approach stalls
+WAYPOINT = "waypoint"  # the leader's own entries in its approach stalls: near its waypoint,
+TRAPPED = "trapped"  # and farther off
 PROGRESS = 0.5  # m a stalled teammate must gain to be waited for again (Stalls, OverwatchParams.patience)
 
 
@@ -262,7 +263,8 @@ def wedge(rank: int, params: OverwatchParams) -> tuple[float, float]:
 class Driver:
     """Goal-seeking with IR avoidance (the thesis gives no control laws): head for a goal direction pushed away
     from whatever the IR ring sees nearer than ``avoid_range``, slowing down for anything ahead; a kind without
-    point turns (the tricycle) keeps creeping forward while it turns."""
+    point turns (the tricycle) keeps creeping forward while it turns and backs off what it nears ahead
+    (docs/decisions.md, bounding overwatch, "Driving")."""
 
     def __init__(self, params: OverwatchParams, omega_max: float, point_turns: bool):
         self.params, self.omega_max, self.point_turns = params, omega_max, point_turns
@@ -270,12 +272,25 @@ class Driver:
         self.track: list = []  # (time, x, y, heading) while asked to move
         self.escape_until, self.escape_turn, self.escapes = -math.inf, 0.0, 0
 
-    def __call__(self, obs: Observation, pose: np.ndarray, direction: np.ndarray, speed: float) -> tuple[float, float]:
+    def __call__(self, obs: Observation, pose: np.ndarray, direction: np.ndarray, speed: float,
+                 through_gap: bool = False) -> tuple[float, float]:
+        """``through_gap``: head for the clear IR direction nearest the goal's instead of the goal pushed away from
+        what the IR sees (:meth:`OverwatchRobot._trapped`)."""
         if obs.time < self.escape_until:
             return -0.12, self.escape_turn
-        v, omega, error = self._steer(obs, pose, direction, speed)
+        v, omega, error = self._steer(obs, pose, direction, speed, through_gap)
+        if not self.point_turns and self.closest_ahead(obs) < self.params.stop_range:
+            return self._back_off(obs.time, error)
         self._watch(obs.time, pose, v, omega, error)
         return v, omega
+
+    def _back_off(self, now: float, error: float) -> tuple[float, float]:
+        """Back off for ``escape_time``, turning towards the goal side: with the nose swinging that way the robot
+        then drives off past what was ahead (a three-point turn for the tricycle). (Backing one control step at a
+        time, with the turn reversed to keep its wheel angle, a tricycle undid each creep's turn and stood 0.2 m
+        from its dead predecessor for 820 s: kill:@leader@14, seed 126.)"""
+        self.escape_until, self.escape_turn = now + self.params.escape_time, math.copysign(0.4, error)
+        return -0.12, self.escape_turn
 
     def _watch(self, now: float, pose: np.ndarray, v: float, omega: float, error: float) -> None:
         """Stuck (wedged against a dead robot, a tricycle nose-on to something): back off, turning to the goal."""
@@ -290,12 +305,12 @@ class Driver:
         moved = max(math.hypot(x - x0, y - y0) for _, x, y, _ in self.track)
         turned = max(abs(wrap_angle(h - h0)) for _, _, _, h in self.track)
         if moved < p.stuck_moved and turned < 0.3:
-            self.escape_until, self.escape_turn = now + p.escape_time, math.copysign(0.4, error)
+            self._back_off(now, error)
             self.escapes += 1
         self.track.clear()
 
-    def _steer(self, obs: Observation, pose: np.ndarray, direction: np.ndarray,
-               speed: float) -> tuple[float, float, float]:
+    def _steer(self, obs: Observation, pose: np.ndarray, direction: np.ndarray, speed: float,
+               through_gap: bool) -> tuple[float, float, float]:
         p = self.params
         ranges, bearings = obs.ir_range, obs.ir_bearings
         near = ranges < p.avoid_range
@@ -308,7 +323,7 @@ class Driver:
         closest = self.closest_ahead(obs)
         norm = float(np.hypot(*direction))
         goal = direction / norm if norm > 1e-9 else np.zeros(2)
-        want = goal + p.avoid_gain * push
+        want = self._gap(obs, pose, goal) if through_gap else goal + p.avoid_gain * push
         if float(np.hypot(*want)) < 1e-6:
             return 0.0, 0.0, 0.0
         error = wrap_angle(math.atan2(want[1], want[0]) - pose[2])
@@ -321,9 +336,18 @@ class Driver:
             v *= float(np.clip((closest - p.stop_range) / (p.avoid_range - p.stop_range), 0.0, 1.0))
             if not self.point_turns and closest > p.stop_range and abs(error) > 0.3:
                 v = max(v, 0.05)  # a tricycle turns only while it rolls
-        if closest < p.stop_range and not self.point_turns:
-            v, omega = -0.08, -omega  # a tricycle backs off what it cannot turn away from
         return v, omega, error
+
+    def _gap(self, obs: Observation, pose: np.ndarray, goal: np.ndarray) -> np.ndarray:
+        """The direction of the IR ray reading clear (beyond ``avoid_range``) nearest the goal's; the goal's if
+        every ray sees something."""
+        clear = obs.ir_range >= self.params.avoid_range
+        if not clear.any():
+            return goal
+        angles = pose[2] + obs.ir_bearings[clear]
+        off_goal = np.remainder(angles - math.atan2(goal[1], goal[0]) + np.pi, 2 * np.pi) - np.pi
+        best = angles[np.argmin(np.abs(off_goal))]
+        return np.array([math.cos(best), math.sin(best)])
 
     def closest_ahead(self, obs: Observation) -> float:
         if self.ahead is None:
@@ -543,8 +567,19 @@ class OverwatchRobot:
             self.bound_log[-1].end = obs.time
             self.k.bounds, me.leading = bound + 1, None
             return Command()
-        v, w = self.drive(obs, self.pose, offset, p.lead_speed * slow * min(1.0, distance / 1.0 + 0.3))
+        v, w = self.drive(obs, self.pose, offset, p.lead_speed * slow * min(1.0, distance / 1.0 + 0.3),
+                          through_gap=self._trapped(obs.time, distance, slow))
         return Command(v=v, omega=w)
+
+    def _trapped(self, now: float, distance: float, slow: float) -> bool:
+        """Beyond ``blocked_radius`` of its waypoint, not held back for its followers, and no nearer by PROGRESS
+        for ``patience`` seconds: boxed in, it steers through the clear gap nearest its waypoint until it gains
+        ground. (Pushed by the IR from three robots at 0.14-0.19 m, its dead predecessor among them, the next
+        leader spun in place at the gathering point for 850 s: kill:@leader@48.9, seed 167.)"""
+        if distance <= self.params.blocked_radius or slow < 1.0:
+            self.approach.forget(TRAPPED)
+            return False
+        return self.approach.stalled(TRAPPED, now, distance, self.params.patience)
 
     def _blocked(self, now: float, distance: float, slow: float) -> bool:
         """Within ``blocked_radius`` of its waypoint and no nearer by PROGRESS for ``patience`` seconds, and not

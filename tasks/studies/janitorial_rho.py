@@ -221,8 +221,8 @@ def report(study: JanitorialRhoStudy, rows: list[dict]) -> str:
         lines.append(f"| {found.claim} | {found.thesis} | {found.teamsim} | {'-' if pairs is None else pairs} | "
                      f"{'-' if math.isnan(found.p) else f'{found.p:.2g}'} | "
                      f"{found.verdict}{', not decided by this sample' if undecided else ''} |")
-    lines += ["", "![mission time per rate](times.png)", "", *time_uses(rows, rhos), "", "## Why teamsim may differ", "",
-              DIFFERENCES]
+    lines += ["", "![mission time per rate](times.png)", "", *time_uses(rows, rhos), "",
+              "## Why teamsim may differ", "", DIFFERENCES]
     return "\n".join(lines) + "\n"
 
 

@@ -12,7 +12,7 @@ from teamsim.controllers.base import Observation
 from teamsim.controllers.behaviours.bounding_overwatch import (EMERGE, FOLLOW, JOIN, LEAD, OVERWATCH, DeadReckoning,
                                                                Driver, Knowledge, OverwatchParams, OverwatchRobot,
                                                                wedge)
-from teamsim.positioning import PoseFix
+from teamsim.positioning import PoseFix, wrap_angle
 from teamsim.radio import Message
 
 ROUTE = [(5.0, 2.0), (9.0, -2.0), (13.0, 2.0)]
@@ -265,3 +265,64 @@ def test_a_leader_held_off_its_waypoint_by_something_there_has_arrived_after_pat
     gaining = robot("cyan")
     assert not any(gaining._blocked(t, near - 0.6 * k, 1.0) for k, t in enumerate((0.0, p.patience / 2 + 1)))
     assert not gaining._blocked(p.patience + 2.0, near - 0.6, 1.0)  # the clock restarted when it gained 0.6 m
+
+
+# Real readings (bounding-overwatch, leader killed): the next leader in the crowd at the gathering point.
+SEED167_RANGES = np.array([0.21, 0.976, 0.838, math.inf, math.inf, math.inf, math.inf, 0.079, math.inf, math.inf])
+SEED167_BEARINGS = np.arange(10) * 0.6283  # a differential drive's ten IR sensors
+SEED126_RANGES = np.array([0.147, math.inf, math.inf, math.inf, math.inf, math.inf, 0.422, math.inf, math.inf, 1.142,
+                           0.331])
+SEED126_BEARINGS = np.arange(11) * 0.5712  # a tricycle's eleven
+
+
+def reading(t: float, pose, ranges, bearings) -> Observation:
+    return Observation(time=t, robot="cyan", ir_raw=np.zeros(len(ranges)), ir_range=ranges, ir_bearings=bearings,
+                       pose=PoseFix(pose[0], pose[1], pose[2], t), velocity=(0.0, 0.0))
+
+
+def test_a_trapped_leader_heads_through_the_clear_gap_nearest_its_waypoint():
+    """kill:@leader@48.9, seed 167, t = 116 s: a differential drive among three robots (one its dead predecessor),
+    its waypoint at bearing 0.18 rad. Pushed by the IR it turns left, away from the waypoint (it spun in place for
+    850 s); through the gap it turns right, towards the clear ray at 0.21 rad."""
+    pose = np.array([-8.014, 1.639, 1.463])
+    goal = np.array([-3.25, 2.5]) - pose[:2]
+    drive = Driver(OverwatchParams(), omega_max=0.45, point_turns=True)
+    seen = reading(116.0, pose, SEED167_RANGES, SEED167_BEARINGS)
+    assert drive(seen, pose, goal, 0.25)[1] > 0.0
+    gap = drive._gap(seen, pose, goal)
+    assert math.atan2(gap[1], gap[0]) == pytest.approx(wrap_angle(pose[2] + SEED167_BEARINGS[8]))
+    v, omega = drive(seen, pose, goal, 0.25, through_gap=True)
+    assert v == 0.0 and omega == pytest.approx(-0.45)  # a point turn first: the gap is 1.26 rad to its right
+    blind = reading(116.0, pose, np.full(10, 0.1), SEED167_BEARINGS)
+    assert np.allclose(drive._gap(blind, pose, goal), goal)  # no clear ray: the goal's direction
+
+
+def test_a_leader_that_gains_no_ground_far_from_its_waypoint_is_trapped_after_patience():
+    """Beyond blocked_radius, not held back, no nearer by 0.5 m for patience: trapped, until it gains ground."""
+    p = OverwatchParams()
+    far = p.blocked_radius + 3.0
+    leader = robot("red")
+    assert not leader._trapped(0.0, far, 1.0)
+    assert not leader._trapped(p.patience - 1.0, far - 0.3, 1.0)
+    assert leader._trapped(p.patience + 1.0, far - 0.3, 1.0)
+    assert not leader._trapped(p.patience + 2.0, far - 0.9, 1.0)  # gained 0.9 m: the clock restarts
+    held = robot("blue")
+    assert not any(held._trapped(t, far, 0.5) for t in (0.0, 3 * p.patience))  # waiting for its followers
+    near = robot("cyan")
+    assert not any(near._trapped(t, p.blocked_radius - 0.1, 1.0) for t in (0.0, 3 * p.patience))
+
+
+def test_a_tricycle_backs_off_what_is_ahead_for_escape_time_turning_to_its_goal_side():
+    """kill:@leader@14, seed 126, t = 92.2 s: a tricycle 0.15 m from its dead predecessor, its want (goal and IR
+    push) to its left. It backs off for escape_time with its nose swinging left, also once the reading clears.
+    (Backing one step at a time with the turn reversed, each creep's turn was undone: 820 s at 0.2 m.)"""
+    p = OverwatchParams()
+    pose = np.array([-9.23, 1.725, 0.859])
+    goal = np.array([-3.25, 2.5]) - pose[:2]
+    drive = Driver(p, omega_max=0.45, point_turns=False)
+    assert drive(reading(92.2, pose, SEED126_RANGES, SEED126_BEARINGS), pose, goal, 0.25) == (-0.12, 0.4)
+    clear = np.full(11, math.inf)
+    during = [drive(reading(92.3 + 0.1 * k, pose, clear, SEED126_BEARINGS), pose, goal, 0.25)
+              for k in range(round(p.escape_time / 0.1) - 2)]
+    assert all(command == (-0.12, 0.4) for command in during)
+    assert drive(reading(92.2 + p.escape_time + 0.1, pose, clear, SEED126_BEARINGS), pose, goal, 0.25)[0] > 0.0
