@@ -34,7 +34,8 @@ class DustParams:
     approach_timeout: float = 20.0  # s
     circle_turn: float = 2 * math.pi  # rad round the object, and its surface seen in seen_sectors of 12 directions
     seen_sectors: int = 11  # (a teammate in the way pushes the robot off a side, which it then has not dusted)
-    circle_timeout: float = 150.0  # s: an object not circled by then is taken as done (its sides are blocked)
+    circle_timeout: float = 150.0  # s: an object not circled by then is taken as done (its sides are blocked) if
+    # the robot got half round it; short of that it lost the object, which stays to be found
     follow: FollowParams = FollowParams(gap=0.08, speed=0.15, ahead=0.15)
     drive: DriveParams = DriveParams(cruise=0.25, turn_rate=1.0)
     bounce: float = 0.35  # m from the rim: the search's random walk turns away from anything this near ahead
@@ -118,10 +119,9 @@ class DustFurniture:
                 return self._walk(obs, pose)
             self._state, self._since, self.target, self._sighted = "approach", obs.time, sighting, sighting
         if self._state == "approach":
-            ahead = np.abs(self.bearings) < math.radians(40)
-            near = obs.ir_range[self.low][ahead].min()
+            near, facing = self._near_target(obs, pose)
             if near < p.approach_gap:
-                if obs.ir_range[self.upper][ahead].min() < near + p.upper_clear:  # tall after all
+                if obs.ir_range[self.upper][facing].min() < near + p.upper_clear:  # tall after all
                     self.tall.append(self.target)
                     self._state = "search"
                     return Command(extras={"duster": 0.0})
@@ -135,6 +135,27 @@ class DustFurniture:
                 v, omega = steer_to(pose, self.target, p.drive, 0.0) or (0.0, 0.0)
                 return Command(v=v, omega=omega, extras={"duster": 0.0})
         return self._circle(obs, pose)
+
+    def _near_target(self, obs: Observation, pose: np.ndarray) -> tuple[float, np.ndarray]:
+        """The lower ring's nearest reading ahead that is of the target (the surface it reads lies within
+        ``same_object`` / 2 of the sighting, ``same_object`` of a dusted object's centre being verified), and the
+        sensors that looked. Anything else ahead (the can just emptied, the object just circled) is not the
+        target: judged by it, the target was taken for tall and ignored for good, or "circled" from metres away
+        (janitorial-rho study, seeds 7, 6 and 2; docs/decisions.md, janitorial, "Dusting")."""
+        p = self.params
+        to = self.target - pose[:2]
+        toward = math.atan2(to[1], to[0]) - pose[2]
+        facing = (np.abs(self.bearings) < math.radians(40)) & \
+            (np.abs([wrap_angle(float(b) - toward) for b in self.bearings]) < math.radians(40))
+        low = obs.ir_range[self.low]
+        tolerance = p.same_object if self._verifying else p.same_object / 2
+        near = math.inf
+        for k in np.flatnonzero(facing & np.isfinite(low)):
+            bearing = pose[2] + self.bearings[k]
+            seen = pose[:2] + (self.rim + low[k]) * np.array([math.cos(bearing), math.sin(bearing)])
+            if np.hypot(*(seen - self.target)) < tolerance:
+                near = min(near, float(low[k]))
+        return near, facing
 
     def _circle(self, obs: Observation, pose: np.ndarray) -> Command:
         p = self.params
@@ -152,8 +173,10 @@ class DustFurniture:
                 obs.time - self._since > p.circle_timeout:
             if self._verifying:
                 self.verified.append(self.verify_at.copy())  # as it was announced, so teammates match it
-            else:
+            elif self._swept >= p.circle_turn / 2:
                 self.finished.append(self.target.copy())
+            # else: timed out short of half round it, the follower lost it (rho 0.5 seed 2: it followed the wall
+            # round the room instead, and the object counted done at 38 % of its sides): it stays to be found.
             self._state, self.target = "search", None
             return Command(extras={"duster": 0.0})
         v, omega = self.follow(ranges)

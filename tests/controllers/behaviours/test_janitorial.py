@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from teamsim.controllers.alliance.motivation import AllianceParams, AllianceRobot, BehaviourSet, MotivationRates
-from teamsim.controllers.behaviours.janitorial.dusting import DustClaims
+from teamsim.controllers.behaviours.janitorial.dusting import DustClaims, DustParams
 from teamsim.controllers.behaviours.janitorial.floor import BLOCKED, VISITED, CoverageGrid, next_cell
 from teamsim.models import build_robot
 from teamsim.radio import Message
@@ -166,3 +166,57 @@ def test_a_verification_set_goes_on_to_the_next_quadrant_or_object_once_one_is_v
         brain(_observation(robot, t + 0.1))
         assert brain.active == VERIFY_DUST and brain.dust.verify_at is not None
         assert np.hypot(*(brain.dust.verify_at - first)) > 0.5
+
+
+def _duster(heading_readings: dict[float, tuple[float, float]], time: float = 0.0):
+    """r1's dust-furniture behaviour and an observation at the origin facing +x in which the lower and upper IR
+    sensors at the given bearings (degrees) read (lower, upper); every other sensor reads nothing."""
+    from teamsim.controllers.base import Observation
+    from teamsim.controllers.behaviours.janitorial.dusting import DustFurniture
+    from teamsim.positioning import PoseFix
+
+    robot = build_robot("janitor", "r1", tools=("empty-garbage", "dust-furniture"))
+    names = robot.ir_sensors
+    upper = np.array([k for k, n in enumerate(names) if n.startswith("ir")])
+    low = np.array([k for k, n in enumerate(names) if n.startswith("low")])
+    bearings = np.asarray(robot.ir_bearings)
+    dust = DustFurniture(bearings, upper, low, robot.footprint_radius, np.random.default_rng(0))
+    ranges = np.full(len(names), np.inf)
+    for degrees, (lower_reading, upper_reading) in heading_readings.items():
+        ranges[low[np.argmin(np.abs(np.degrees(bearings[low]) - degrees))]] = lower_reading
+        ranges[upper[np.argmin(np.abs(np.degrees(bearings[upper]) - degrees))]] = upper_reading
+    obs = Observation(time=time, robot="r1", ir_raw=np.zeros(len(names)), ir_range=ranges, ir_bearings=bearings,
+                      pose=PoseFix(0.0, 0.0, 0.0, time), velocity=(0.0, 0.0))
+    return dust, obs, robot.footprint_radius
+
+
+def _approaching(dust, target) -> None:
+    dust._state, dust._since, dust.target, dust._sighted = "approach", 0.0, np.array(target), np.array(target)
+
+
+def test_an_approach_judges_the_target_by_the_sensors_that_see_it():
+    """A can 3 cm ahead while the sighted object lies behind (rho study rho 0 seed 7: the robot had just emptied
+    it, took the object for tall and ignored it for 2300 s): not the target, the approach goes on. The target
+    itself, 0.1 m ahead, is circled if the upper ring is clear there and taken for tall if not."""
+    dust, can_ahead, rim = _duster({0.0: (0.03, 0.04)}, time=1.0)
+    _approaching(dust, (-0.8, 0.0))
+    dust(can_ahead, np.zeros(3))
+    assert dust._state == "approach" and dust.tall == []
+    dust, low_object, rim = _duster({0.0: (0.1, np.inf)}, time=1.0)
+    _approaching(dust, (rim + 0.1, 0.0))
+    dust(low_object, np.zeros(3))
+    assert dust._state == "circle"
+    dust, tall_thing, rim = _duster({0.0: (0.1, 0.12)}, time=1.0)
+    _approaching(dust, (rim + 0.1, 0.0))
+    dust(tall_thing, np.zeros(3))
+    assert dust._state == "search" and len(dust.tall) == 1
+
+
+@pytest.mark.parametrize("swept, done", [(1.0, False), (3.5, True)])
+def test_a_circle_that_times_out_short_of_half_round_does_not_count_the_object_dusted(swept, done):
+    """rho 0.5 seed 2: the follower lost the object at a corner, followed the wall round the room and the object,
+    swept -3.9 rad, was counted dusted at 38 % of its sides. Timed out, it counts only past half a turn."""
+    dust, nothing, _ = _duster({}, time=DustParams().circle_timeout + 1.0)
+    dust._state, dust._since, dust.target, dust._sighted, dust._swept = "circle", 0.0, np.ones(2), np.ones(2), swept
+    dust(nothing, np.zeros(3))
+    assert dust._state == "search" and len(dust.finished) == int(done)
