@@ -99,6 +99,7 @@ class BoxPushParams:
     # 0.01-0.05 m/s against 0.3 asked), closing in freely it is past this speed within 0.2 s (0.5 m/s^2).
     stall_speed: float = 0.1  # m/s
     stall_time: float = 0.6  # s closing in before a crawl counts as contact
+    back_slack: float = 0.6  # s to reverse from cruise, allowed a back-up on top of twice its own time
     square_gain: float = 2.0  # rad/s per m of difference between the two fingertip readings
     whisker_gain: float = 0.02  # rad/s per N of difference between the two whiskers' contact forces
     whisker_timeout: float = 8.0  # s Genghis-II walks towards the box before its push time runs without a touch
@@ -220,9 +221,18 @@ class PushEnd:
 
     # -- acquiring the end -----------------------------------------------------------------------------------
     def _back_off(self, obs: Observation) -> Command:
-        if self._moved() >= self.params.standoff:
+        if self._backed(obs, self.params.standoff):
             return self._go("turn_along", obs)
         return self.drive(-self.params.drive.back_speed)
+
+    def _backed(self, obs: Observation, distance: float) -> bool:
+        """Backed ``distance`` by the encoders, or as far as it can: the back bumper presses on something (a wall),
+        or it has backed twice as long as the distance takes and ``back_slack`` more (docs/decisions.md, "Backing
+        ends at a wall")."""
+        p = self.params
+        pressed = obs.touch.get("bump_back", 0.0) >= p.drive.bump_force
+        too_long = obs.time - self.mark[0] >= 2 * distance / p.drive.back_speed + p.back_slack
+        return self._moved() >= distance or pressed or too_long
 
     def along(self) -> float:
         """Heading along the box towards this set's end: the left end lies to the left of the push heading."""
@@ -298,13 +308,13 @@ class PushEnd:
         return bool(heard if self.station.claimants is None else heard & self.station.claimants)
 
     def _back_in(self, obs: Observation) -> Command:
-        if self._moved() >= self.params.end_overrun + self.params.end_inset:
+        if self._backed(obs, self.params.end_overrun + self.params.end_inset):
             return self._go("turn_in", obs)
         return self.drive(-self.params.drive.back_speed)
 
     def _clear(self, obs: Observation) -> Command:
         """Blocked while following: back up ``block_backoff`` along the box, then turn into it here."""
-        if self._moved() >= self.params.block_backoff:
+        if self._backed(obs, self.params.block_backoff):
             return self._go("turn_in", obs)
         return self.drive(-self.params.drive.back_speed)
 

@@ -422,3 +422,27 @@ def test_blocked_beside_a_withdrawn_teammate_it_pushes_from_there_at_once():
     obs = follow_observation(0.2, near, speed=0.0, present=frozenset({"green"}))
     estimate.update(obs)
     assert push(obs).v == 0.0 and push.state == "follow"
+
+
+@pytest.mark.parametrize("bump_back", [31.6, 0.0])
+def test_backing_against_a_wall_ends_on_the_back_bumper_or_after_twice_its_time(bump_back):
+    """Backing in from past an end with its back on the wall, encoders still (kill:green@33.1, seed 8: 0.17 of the
+    0.19 m, 31.6 N on the back bumper, for the last 214 s of the run): the back-up ends at once on the bumper, and
+    without it after twice the time the distance takes and back_slack more. Then the robot turns in."""
+    params = BoxPushParams()
+    push, estimate, station = following(params)
+    station.end = RIGHT
+    obs = follow_observation(0.0, (math.inf, math.inf), speed=0.0)
+    estimate.update(obs)
+    push.state, push.since, push.mark = "back_in", 0.0, (0.0, estimate.pose.copy())
+    limit = 2 * (params.end_overrun + params.end_inset) / params.drive.back_speed + params.back_slack
+    t = 0.0
+    while push.state == "back_in":
+        t = round(t + 0.1, 6)
+        obs = follow_observation(t, (math.inf, math.inf), speed=0.0)
+        obs = obs.__class__(**{**obs.__dict__, "touch": {"bump_back": bump_back}})
+        estimate.update(obs)
+        push(obs)
+        assert t <= limit + 0.2, "still backing into the wall"
+    assert push.state == "turn_in"
+    assert t == pytest.approx(0.1 if bump_back else limit, abs=0.11)
