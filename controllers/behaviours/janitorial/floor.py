@@ -36,6 +36,7 @@ class FloorParams:
     least_perimeter: float = 8.0  # m: no room is smaller round than this (a janitor needs a room 2 m across),
     wall_range: float = 0.8  # m from the rim: readings this near, round the circuit, find the walls
     least_side: float = 2.0  # m: nor are the extents of the robot's centre going round it (a pocket among obstacles)
+    side_share: float = 0.5  # a circuit ended by its turning has driven along this share of each side of its room
     arrive: float = 0.2  # m: a cell is reached (and visited) when its centre is this near
     cell_timeout: float = 8.0  # s (and timeout_per_metre of its distance) to reach a cell before it counts as
     timeout_per_metre: float = 8.0  # inaccessible
@@ -158,6 +159,7 @@ class CleanFloor:
         self.home: np.ndarray | None = None  # the robot's start pose (set on its first step if not given)
         self._homed = False
         self._wall_hits: list[np.ndarray] = []
+        self._track: list[np.ndarray] = []  # the robot's positions round the circuit
         self._target: tuple[int, int] | None = None
         self._deadline = 0.0  # a target not reached by then is inaccessible
         self._route: list = []  # cells to the target
@@ -182,8 +184,9 @@ class CleanFloor:
         """Back to the start (the robots start beside a wall, on their left, as Parker's start in a corner), straight
         to that wall, then follow it round with it on the right. A loop that turned left in all went round the
         room: it is complete back where it began, or once past a fifth corner (a circuit begun on an obstacle
-        off the wall never comes back to its start), if it is room-sized and holds the start (a pocket among
-        obstacles does not). One that turned right (by 1.5 pi) went
+        off the wall never comes back to its start) if it has driven along the four sides of its rectangle (a
+        U-turn at a teammate by the wall turns as far as two corners), if it is room-sized and holds the start
+        (a pocket among obstacles does not). One that turned right (by 1.5 pi) went
         round an obstacle, which the robot leaves, turning left, to find a wall."""
         p = self.params
         ranges = obs.ir_range[self.low]
@@ -206,19 +209,22 @@ class CleanFloor:
             if ranges[self.follow.front].min(initial=math.inf) >= p.follow.ahead + 0.05:
                 return self._clean(p.follow.speed, 0.0)
             self._circuit_start, self._extents = pose[:2].copy(), np.array([pose[0], pose[0], pose[1], pose[1]])
-            self._wall_hits = []
+            self._wall_hits, self._track = [], []
             self._path, self._turned, self._last_heading, self._last_position = 0.0, 0.0, pose[2], pose[:2].copy()
         x, y = pose[:2]
         e = self._extents
         self._extents = np.array([min(e[0], x), max(e[1], x), min(e[2], y), max(e[3], y)])
         self._wall_hits.append(self._hits(ranges, pose, p.wall_range))
+        self._track.append(pose[:2].copy())
         self._turned += wrap_angle(pose[2] - self._last_heading)
         self._last_heading = pose[2]
         self._path += float(np.hypot(*(pose[:2] - self._last_position)))
         self._last_position = pose[:2].copy()
         gone = float(np.hypot(*(pose[:2] - self._circuit_start)))
         closed = self._path > p.leave and gone < p.home
-        round_room = self._turned > 2.5 * math.pi and self._path > p.least_perimeter  # (not spinning on the spot)
+        round_room = self._turned > 2.5 * math.pi and self._path > p.least_perimeter \
+            and (self._went_round(self._room_bounds())  # (not spinning on the spot, nor turning back at a teammate)
+                 or self._turned > 6.5 * math.pi)  # three laps: what kept it off a side is there for good
         if self._turned < -1.5 * math.pi or round_room or closed:
             e = self._extents
             bounds = self._room_bounds()
@@ -232,6 +238,21 @@ class CleanFloor:
             self._circuit_start = None
             return self._clean(0.0, 0.0)
         return self._clean(*self.follow(ranges))
+
+    def _went_round(self, bounds: tuple[float, float, float, float]) -> bool:
+        """Whether the circuit drove along every side of ``bounds``: for each, ``side_share`` of its cell-long
+        stretches hold a position within ``home`` of it. Left turns alone are no proof: a U-turn where a teammate
+        stood by the wall counts as two corners (r2, seed 228: a circuit of the room's lower half, 2.5 pi
+        turned, was taken for the room and its upper quadrants, the middle of the room, cleaned in a minute)."""
+        p, track = self.params, np.asarray(self._track)
+        x0, x1, y0, y1 = bounds
+        for line, across, lo, hi in ((y0, 1, x0, x1), (y1, 1, x0, x1), (x0, 0, y0, y1), (x1, 0, y0, y1)):
+            along = track[np.abs(track[:, across] - line) < p.home, 1 - across]
+            n = max(1, round((hi - lo) / p.cell))
+            stretches = np.unique(np.clip(((along - lo) / max(hi - lo, 1e-9) * n).astype(int), 0, n - 1))
+            if len(stretches) < p.side_share * n:
+                return False
+        return True
 
     def _room_bounds(self) -> tuple[float, float, float, float]:
         """Where the robot's centre can go: the walls, as the extremes (1st and 99th percentiles, against IR noise)

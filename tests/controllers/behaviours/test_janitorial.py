@@ -220,3 +220,30 @@ def test_a_circle_that_times_out_short_of_half_round_does_not_count_the_object_d
     dust._state, dust._since, dust.target, dust._sighted, dust._swept = "circle", 0.0, np.ones(2), np.ones(2), swept
     dust(nothing, np.zeros(3))
     assert dust._state == "search" and len(dust.finished) == int(done)
+
+
+def _circuit(corners, step: float = 0.1) -> list[np.ndarray]:
+    """Positions every ``step`` m along straight legs through ``corners``."""
+    track = []
+    for a, b in zip(corners, corners[1:]):
+        a, b = np.array(a, float), np.array(b, float)
+        n = max(1, int(np.hypot(*(b - a)) / step))
+        track += [a + (b - a) * k / n for k in range(n)]
+    return track
+
+
+def test_a_circuit_counts_as_the_room_only_once_it_drove_along_every_side():
+    """Seed 228: r2 went down the west wall, along the south wall and up the east wall to a teammate standing by
+    it, turned back (2.5 pi in all) and took the room's lower half for the room. Along all four sides of its
+    rectangle, a loop is the room; missing one, it is not."""
+    from teamsim.controllers.behaviours.janitorial.floor import CleanFloor
+
+    robot = build_robot("janitor", "r2", tools=("empty-garbage", "clean-floor"))
+    low = np.array([k for k, n in enumerate(robot.ir_sensors) if n.startswith("low")])
+    floor = CleanFloor(np.asarray(robot.ir_bearings), low, robot.footprint_radius, np.random.default_rng(0))
+    room = (-3.2, 3.2, -2.35, 2.35)
+    floor._track = _circuit([(-3.2, 0.0), (-3.2, -2.35), (3.2, -2.35), (3.2, 2.35), (-3.2, 2.35), (-3.2, 0.0)])
+    assert floor._went_round(room)
+    floor._track = _circuit([(-3.2, -0.16), (-3.2, -2.35), (3.2, -2.35), (3.2, -0.18), (2.6, -0.2)])
+    assert not floor._went_round((-3.15, 3.22, -2.41, 0.07))  # r2's learned room: its top side never driven
+    assert not floor._went_round(room)
