@@ -33,6 +33,8 @@ class FloorParams:
     cell: float = 0.3  # m: the grid's cell, 3/4 of the cleaner's width (neighbouring legs overlap; positions are noisy)
     leave: float = 2.0  # m: the perimeter circuit ends back within ``home`` of its start after driving this far
     home: float = 0.5
+    home_stall: float = 30.0  # s: the way back to the start that gets no ``headway`` nearer in this long is blocked
+    headway: float = 0.1  # m
     least_perimeter: float = 8.0  # m: no room is smaller round than this (a janitor needs a room 2 m across),
     wall_range: float = 0.8  # m from the rim: readings this near, round the circuit, find the walls
     least_side: float = 2.0  # m: nor are the extents of the robot's centre going round it (a pocket among obstacles)
@@ -158,6 +160,8 @@ class CleanFloor:
         self._away: float | None = None  # heading to leave a circled obstacle on, or to face the first wall
         self.home: np.ndarray | None = None  # the robot's start pose (set on its first step if not given)
         self._homed = False
+        self._nearest_home: float | None = None  # m: the nearest the way back to the start has come (this activation)
+        self._headway_at = 0.0  # s: when it last came ``headway`` nearer
         self._wall_hits: list[np.ndarray] = []
         self._track: list[np.ndarray] = []  # the robot's positions round the circuit
         self._target: tuple[int, int] | None = None
@@ -171,6 +175,7 @@ class CleanFloor:
     def start(self, quadrant: str, time: float, verify: bool = False) -> None:
         """Clean ``quadrant``; ``verify``: again, every cell of it unvisited (and unmarked) once more."""
         self.quadrant, self._target, self._verifying = quadrant, None, verify
+        self._nearest_home = None  # (the way back is timed while this behaviour runs)
         if verify and self.grid is not None:
             self.grid.state[self.grid.quadrant(quadrant)] = UNVISITED
 
@@ -187,11 +192,16 @@ class CleanFloor:
         off the wall never comes back to its start) if it has driven along the four sides of its rectangle (a
         U-turn at a teammate by the wall turns as far as two corners), if it is room-sized and holds the start
         (a pocket among obstacles does not). One that turned right (by 1.5 pi) went
-        round an obstacle, which the robot leaves, turning left, to find a wall."""
+        round an obstacle, which the robot leaves, turning left, to find a wall. A way back to the start that gets
+        no nearer it for ``home_stall`` is blocked, and the circuit begins at what is in the way."""
         p = self.params
         ranges = obs.ir_range[self.low]
         if self.home is None:
             self.home = pose.copy()
+        if not self._homed and self._blocked_home(obs.time, pose):
+            # Something stands between the robot and its start and avoid-obstacles only rocks it there: the circuit
+            # begins at what is in the way (docs/decisions.md, janitorial, "The way back to the start").
+            self._homed, self._away = True, None
         if not self._homed:  # back to the start, beside a wall, and face that wall (on the left at the start)
             detour = self.avoid(obs)
             if detour is not None:
@@ -238,6 +248,14 @@ class CleanFloor:
             self._circuit_start = None
             return self._clean(0.0, 0.0)
         return self._clean(*self.follow(ranges))
+
+    def _blocked_home(self, time: float, pose: np.ndarray) -> bool:
+        """Whether the way back to the start has come no ``headway`` nearer it for ``home_stall`` s."""
+        p = self.params
+        gone = float(np.hypot(*(pose[:2] - self.home[:2])))
+        if self._nearest_home is None or gone < self._nearest_home - p.headway:
+            self._nearest_home, self._headway_at = gone, time
+        return time - self._headway_at > p.home_stall
 
     def _went_round(self, bounds: tuple[float, float, float, float]) -> bool:
         """Whether the circuit drove along every side of ``bounds``: for each, ``side_share`` of its cell-long

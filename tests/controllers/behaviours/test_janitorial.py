@@ -247,3 +247,25 @@ def test_a_circuit_counts_as_the_room_only_once_it_drove_along_every_side():
     floor._track = _circuit([(-3.2, -0.16), (-3.2, -2.35), (3.2, -2.35), (3.2, -0.18), (2.6, -0.2)])
     assert not floor._went_round((-3.15, 3.22, -2.41, 0.07))  # r2's learned room: its top side never driven
     assert not floor._went_round(room)
+
+
+def test_the_way_back_to_the_start_is_blocked_once_it_gets_no_nearer():
+    """Seed 6 at rho 0.1: r2 rocked at the east side of a deck, its start to the west, 2.85-2.9 m from it for
+    1654 s (378 avoid-obstacles detours). A way back that gets no ``headway`` nearer in ``home_stall`` is blocked;
+    one that gets nearer, however slowly, is not, and the timing starts afresh with each activation."""
+    from teamsim.controllers.behaviours.janitorial.floor import CleanFloor
+
+    robot = build_robot("janitor", "r2", tools=("empty-garbage", "clean-floor"))
+    low = np.array([k for k, n in enumerate(robot.ir_sensors) if n.startswith("low")])
+    floor = CleanFloor(np.asarray(robot.ir_bearings), low, robot.footprint_radius, np.random.default_rng(0))
+    floor.home = np.array([-2.25, -1.93, np.pi / 2])
+    stall, step = floor.params.home_stall, floor.params.headway
+    floor.start("lower-left", 0.0)
+    rocking = [np.array([0.7 + 0.05 * (-1) ** k, -1.2, np.pi]) for k in range(int(stall) + 2)]
+    assert not any(floor._blocked_home(float(t), pose) for t, pose in enumerate(rocking[:int(stall)]))
+    assert floor._blocked_home(stall + 1.0, rocking[-1])
+    floor.start("lower-left", 100.0)  # a new activation: timed afresh
+    assert not floor._blocked_home(100.0, rocking[0])
+    floor.start("lower-left", 200.0)
+    nearing = [np.array([0.7 - 1.5 * step * t / stall, -1.2, np.pi]) for t in range(3 * int(stall))]
+    assert not any(floor._blocked_home(200.0 + t, pose) for t, pose in enumerate(nearing))
