@@ -36,6 +36,7 @@ from teamsim.config import setting
 from teamsim.controllers.alliance.motivation import (IDLE, AllianceController, AllianceParams,
                                                      BehaviourSetDefinition, MotivationRates, activity_message)
 from teamsim.controllers.base import Command, Observation
+from teamsim.controllers.navigation.polar_histogram import wrap
 from teamsim.positioning import wrap_angle
 
 GROUPS = ("A", "B")  # A bounds first (the thesis's "first team")
@@ -345,8 +346,7 @@ class Driver:
         if not clear.any():
             return goal
         angles = pose[2] + obs.ir_bearings[clear]
-        off_goal = np.remainder(angles - math.atan2(goal[1], goal[0]) + np.pi, 2 * np.pi) - np.pi
-        best = angles[np.argmin(np.abs(off_goal))]
+        best = angles[np.argmin(np.abs(wrap(angles - math.atan2(goal[1], goal[0]))))]
         return np.array([math.cos(best), math.sin(best)])
 
     def closest_ahead(self, obs: Observation) -> float:

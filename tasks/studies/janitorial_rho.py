@@ -238,13 +238,16 @@ def time_uses(rows: list[dict], rhos: list[float]) -> list[str]:
              "verification or idle time.", "",
              "| rho | " + " | ".join(name.replace("_", " ") for name in TIME_USES) + " |",
              "|---|" + "---|" * len(TIME_USES)]
+    def per_seed(rho: float, name: str) -> dict[int, float]:
+        return {r["seed"]: r[f"{name}_s"] for r in at(rows, rho) if r[f"{name}_s"] is not None}
+
+    first = {name: per_seed(base, name) for name in TIME_USES}
     for rho in rhos:
         cells = []
         for name in TIME_USES:
-            seconds = {r["seed"]: r[f"{name}_s"] for r in at(rows, rho) if r[f"{name}_s"] is not None}
-            first = {r["seed"]: r[f"{name}_s"] for r in at(rows, base) if r[f"{name}_s"] is not None}
-            seeds = sorted(set(seconds) & set(first))
-            p = wilcoxon_p([first[s] for s in seeds], [seconds[s] for s in seeds]) if rho != base else math.nan
+            seconds = per_seed(rho, name)
+            seeds = sorted(set(seconds) & set(first[name]))
+            p = wilcoxon_p([first[name][s] for s in seeds], [seconds[s] for s in seeds]) if rho != base else math.nan
             median = float(np.median(list(seconds.values()))) if seconds else math.nan
             cells.append(_number(median) + ("" if math.isnan(p) else f" (p {p:.2g})"))
         lines.append(f"| {rho:g} | " + " | ".join(cells) + " |")

@@ -19,6 +19,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from teamsim.controllers.base import Command, Observation
+from teamsim.controllers.navigation.polar_histogram import wrap
 from teamsim.controllers.skills.follow_surface import FollowParams, FollowRight
 from teamsim.controllers.skills.goto import DriveParams, steer_to, turn_to
 from teamsim.positioning import wrap_angle
@@ -145,8 +146,7 @@ class DustFurniture:
         p = self.params
         to = self.target - pose[:2]
         toward = math.atan2(to[1], to[0]) - pose[2]
-        facing = (np.abs(self.bearings) < math.radians(40)) & \
-            (np.abs([wrap_angle(float(b) - toward) for b in self.bearings]) < math.radians(40))
+        facing = (np.abs(self.bearings) < math.radians(40)) & (np.abs(wrap(self.bearings - toward)) < math.radians(40))
         low = obs.ir_range[self.low]
         tolerance = p.same_object if self._verifying else p.same_object / 2
         near = math.inf
