@@ -38,7 +38,8 @@ class FloorParams:
     least_perimeter: float = 8.0  # m: no room is smaller round than this (a janitor needs a room 2 m across),
     wall_range: float = 0.8  # m from the rim: readings this near, round the circuit, find the walls
     least_side: float = 2.0  # m: nor are the extents of the robot's centre going round it (a pocket among obstacles)
-    side_share: float = 0.5  # a circuit ended by its turning has driven along this share of each side of its room
+    side_share: float = 0.5  # a circuit has driven along this share of each side of its room
+    loops: int = 3  # closed loops that missed a side before the widest of them counts as the room
     arrive: float = 0.2  # m: a cell is reached (and visited) when its centre is this near
     cell_timeout: float = 8.0  # s (and timeout_per_metre of its distance) to reach a cell before it counts as
     timeout_per_metre: float = 8.0  # inaccessible
@@ -164,6 +165,7 @@ class CleanFloor:
         self._headway_at = 0.0  # s: when it last came ``headway`` nearer
         self._wall_hits: list[np.ndarray] = []
         self._track: list[np.ndarray] = []  # the robot's positions round the circuit
+        self._short_loops: list[tuple[float, float, float, float]] = []  # rooms of loops that missed a side
         self._target: tuple[int, int] | None = None
         self._deadline = 0.0  # a target not reached by then is inaccessible
         self._route: list = []  # cells to the target
@@ -188,10 +190,11 @@ class CleanFloor:
     def _circuit(self, obs: Observation, pose: np.ndarray) -> Command:
         """Back to the start (the robots start beside a wall, on their left, as Parker's start in a corner), straight
         to that wall, then follow it round with it on the right. A loop that turned left in all went round the
-        room: it is complete back where it began, or once past a fifth corner (a circuit begun on an obstacle
-        off the wall never comes back to its start) if it has driven along the four sides of its rectangle (a
-        U-turn at a teammate by the wall turns as far as two corners), if it is room-sized and holds the start
-        (a pocket among obstacles does not). One that turned right (by 1.5 pi) went
+        room: it ends back where it began, or once past a fifth corner (a circuit begun on an obstacle off the
+        wall never comes back to its start), and counts (:meth:`_loop_room`) if it has driven along the four
+        sides of its rectangle (a U-turn at a teammate by the wall turns as far as two corners; a loop begun
+        mid-room can cut through the obstacles), is room-sized and holds the start (a pocket among obstacles
+        does not). One that turned right (by 1.5 pi) went
         round an obstacle, which the robot leaves, turning left, to find a wall. A way back to the start that gets
         no nearer it for ``home_stall`` is blocked, and the circuit begins at what is in the way."""
         p = self.params
@@ -236,11 +239,8 @@ class CleanFloor:
             and (self._went_round(self._room_bounds())  # (not spinning on the spot, nor turning back at a teammate)
                  or self._turned > 6.5 * math.pi)  # three laps: what kept it off a side is there for good
         if self._turned < -1.5 * math.pi or round_room or closed:
-            e = self._extents
-            bounds = self._room_bounds()
-            inside = bounds[0] - p.home <= self.home[0] <= bounds[1] + p.home and \
-                bounds[2] - p.home <= self.home[1] <= bounds[3] + p.home  # the room holds the start
-            if self._turned > math.pi and min(e[1] - e[0], e[3] - e[2]) > p.least_side and inside:
+            bounds = self._loop_room(checked=round_room)
+            if bounds is not None:
                 self.bounds = bounds
                 self.grid = CoverageGrid(self.bounds, p.cell)
             else:
@@ -248,6 +248,25 @@ class CleanFloor:
             self._circuit_start = None
             return self._clean(0.0, 0.0)
         return self._clean(*self.follow(ranges))
+
+    def _loop_room(self, checked: bool) -> tuple[float, float, float, float] | None:
+        """The room the loop just ended went round, or None if it is not one. ``checked``: it was ended by its turning
+        and has already been judged to have driven along every side. A loop back at its start that missed a side
+        went through the obstacles (r2, seed 244: begun at a can mid-room, it cut past the obstacles and
+        took the room without its east strip for the room): the robot leaves it for a wall, and only after
+        ``loops`` such loops takes the widest of them (docs/decisions.md, janitorial, the perimeter circuit)."""
+        p, e = self.params, self._extents
+        bounds = self._room_bounds()
+        inside = bounds[0] - p.home <= self.home[0] <= bounds[1] + p.home and \
+            bounds[2] - p.home <= self.home[1] <= bounds[3] + p.home  # the room holds the start
+        if not (self._turned > math.pi and min(e[1] - e[0], e[3] - e[2]) > p.least_side and inside):
+            return None
+        if checked or self._went_round(bounds):
+            return bounds
+        self._short_loops.append(bounds)
+        if len(self._short_loops) < p.loops:
+            return None
+        return max(self._short_loops, key=lambda b: (b[1] - b[0]) * (b[3] - b[2]))
 
     def _blocked_home(self, time: float, pose: np.ndarray) -> bool:
         """Whether the way back to the start has come no ``headway`` nearer it for ``home_stall`` s."""

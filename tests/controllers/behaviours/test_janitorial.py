@@ -269,3 +269,37 @@ def test_the_way_back_to_the_start_is_blocked_once_it_gets_no_nearer():
     floor.start("lower-left", 200.0)
     nearing = [np.array([0.7 - 1.5 * step * t / stall, -1.2, np.pi]) for t in range(3 * int(stall))]
     assert not any(floor._blocked_home(200.0 + t, pose) for t, pose in enumerate(nearing))
+
+
+def test_a_loop_back_at_its_start_that_missed_a_side_is_not_the_room():
+    """Seed 244: r2's circuit began at a can mid-room (its way back to the start blocked), cut past the obstacles to
+    the north wall and came back to where it began along the west and south walls: the room without its east strip.
+    Such a loop is left for a wall; only after ``loops`` of them does the widest count. A closed loop along all four
+    walls is the room at once."""
+    from teamsim.controllers.behaviours.janitorial.floor import CleanFloor
+
+    robot = build_robot("janitor", "r2", tools=("empty-garbage", "clean-floor"))
+    low = np.array([k for k, n in enumerate(robot.ir_sensors) if n.startswith("low")])
+    floor = CleanFloor(np.asarray(robot.ir_bearings), low, robot.footprint_radius, np.random.default_rng(0))
+    floor.home = np.array([-2.31, -2.15, np.pi / 2])
+    inset = floor.rim + floor.params.follow.gap
+
+    def loop(corners, room):
+        x0, x1, y0, y1 = room
+        floor._track = _circuit(corners)
+        floor._wall_hits = [np.array([[x0 - inset, y0 - inset], [x1 + inset, y1 + inset]] * 50)]
+        floor._extents = np.array([min(c[0] for c in corners), max(c[0] for c in corners),
+                                   min(c[1] for c in corners), max(c[1] for c in corners)])
+        floor._turned = 1.9 * np.pi
+        return floor._loop_room(checked=False)
+
+    cut = [(1.26, -1.59), (0.62, -0.12), (-1.2, 1.0), (-1.2, 2.3), (-3.1, 2.3), (-3.1, -2.3), (1.66, -2.33),
+           (1.26, -1.59)]
+    short = (-3.15, 1.7, -2.37, 2.43)  # r2's room from that loop: x up to 1.7 m of 3.1
+    for _ in range(floor.params.loops - 1):
+        assert loop(cut, short) is None
+    wider = (-3.15, 1.9, -2.37, 2.43)
+    assert loop(cut, wider) == wider  # the third: the widest of them, for want of a better
+    room = (-3.1, 3.1, -2.3, 2.3)
+    floor._short_loops = []
+    assert loop([(-3.1, 0.0), (-3.1, -2.3), (3.1, -2.3), (3.1, 2.3), (-3.1, 2.3), (-3.1, 0.0)], room) == room
