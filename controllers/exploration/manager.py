@@ -120,6 +120,13 @@ class GlobalInfo:
 
     def _on_assigned(self, sender: str, payload: dict, now: float) -> None:
         environment, explorer = payload["environment"], payload["explorer"]
+        if explorer not in self.explorers:
+            # Removed while a planner settled its request: the environment was never its, and nothing would ever
+            # release it (the run went on to MET with it "assigned": kill seeds 130 and 146, docs/decisions.md).
+            self.send("released", {"environment": environment, "status": self.status[environment]})
+            self.log.append({"t": now, "event": "released", "robot": explorer, "environment": environment,
+                             "status": self.status[environment]})
+            return
         self.status[environment] = "assigned"
         record = self.records.get(explorer)
         if record is not None:

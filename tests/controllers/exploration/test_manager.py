@@ -23,3 +23,21 @@ def test_a_reallocation_keeps_finished_explorers_finished_and_starts_newcomers_a
     assert info.explorers == ["Robot4", "Robot2", "Robot7"]
     assert info.finished & set(info.explorers) == {"Robot4", "Robot2"}  # Robot7 is new to the role: not done
     assert [e["robot"] for e in info.log if e["event"] == "explorer removed"] == ["Robot5"]
+
+
+def test_an_assignment_for_an_explorer_removed_meanwhile_takes_no_environment():
+    """Kill seeds 130 and 146: feedback took Robot2's role while a planner settled its request; the planner's
+    "assigned" then marked the environment for a robot that no longer explored, nothing ever released it, and the
+    run went on to MET. Now such an assignment is released at once, to the planners too."""
+    info = manager(["Robot4", "Robot2"])
+    info.bog_capable, info.radii, info.rates = {"Robot4": False, "Robot2": False}, \
+        {"Robot4": 0.3, "Robot2": 0.3}, {"Robot4": 1.0, "Robot2": 1.0}
+    info.receive("Robot2", "request", {"kind": "environment", "position": (0.0, 0.0)}, 0.0)
+    info.step(0.0)
+    info.receive("Robot1", "roles", {"workers": {EXPLORER: ["Robot4"], PLANNER: ["Robot4"]}}, 60.2)
+    info.outbox.clear()
+    info.receive("Robot4", "assigned", {"job_id": 1, "explorer": "Robot2", "environment": 2}, 60.6)
+    assert info.status[2] == "UE" and info.records["Robot2"].environment is None
+    assert [(p.kind, p.payload["environment"]) for p in info.outbox] == [("released", 2)]
+    info.receive("Robot4", "assigned", {"job_id": 2, "explorer": "Robot4", "environment": 3}, 61.0)
+    assert info.status[3] == "assigned"  # a current explorer's assignment stands
