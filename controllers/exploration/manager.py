@@ -92,6 +92,11 @@ class GlobalInfo:
             if not payload.get("bog") or record.bog_turns[given_up] >= BOG_TURNS:
                 record.excluded.add(given_up)
             record.environment = None
+        elif payload["kind"] == "environment" and record.environment is not None:
+            # It asks anew without giving up what it was given: it never took that up (its plan came while it
+            # backed out of a bog and was dropped: kill seed 206), so it goes back, not excluded.
+            self._release(record.environment, sender, now)
+            record.environment = None
         self.queue.request(sender, payload["kind"])
 
     def _on_map(self, sender: str, payload: dict, now: float) -> None:

@@ -41,3 +41,30 @@ def test_an_assignment_for_an_explorer_removed_meanwhile_takes_no_environment():
     assert [(p.kind, p.payload["environment"]) for p in info.outbox] == [("released", 2)]
     info.receive("Robot4", "assigned", {"job_id": 2, "explorer": "Robot4", "environment": 3}, 61.0)
     assert info.status[3] == "assigned"  # a current explorer's assignment stands
+
+
+def test_a_request_for_an_environment_releases_one_the_explorer_never_took_up():
+    """Kill seed 206: Robot2's plan for environment 0 came while it backed out of a bog and was dropped; its next
+    request (giving nothing up) got environment 1, and 0 stayed "assigned" to it until MET. A request for an
+    environment now releases what the manager still has on record for the explorer, without excluding it; a request
+    for a path keeps it."""
+    info = manager(["Robot4", "Robot2"])
+    info.bog_capable, info.radii, info.rates = {"Robot4": True, "Robot2": False}, \
+        {"Robot4": 0.3, "Robot2": 0.3}, {"Robot4": 1.0, "Robot2": 1.0}
+    info.receive("Robot2", "request", {"kind": "environment", "position": (0.0, 0.0)}, 415.4)
+    info.step(415.4)
+    info.receive("Robot4", "assigned", {"job_id": 1, "explorer": "Robot2", "environment": 0}, 417.0)
+    info.receive("Robot4", "job-done", {"job_id": 1}, 417.1)
+    info.outbox.clear()
+    info.receive("Robot2", "request", {"kind": "environment", "position": (0.0, 0.0), "give_up": None,
+                                       "bog": True}, 426.7)
+    assert info.status[0] == "UE" and info.records["Robot2"].environment is None
+    assert [(p.kind, p.payload["environment"]) for p in info.outbox] == [("released", 0)]
+    assert 0 not in info.records["Robot2"].excluded  # never tried: it may have it again
+    info.receive("Robot4", "assigned", {"job_id": 2, "explorer": "Robot2", "environment": 1}, 427.6)
+    info.receive("Robot1", "roles", {"workers": {EXPLORER: ["Robot4"], PLANNER: ["Robot4"]}}, 480.2)
+    assert "assigned" not in info.status  # its removal releases what it held
+    info.receive("Robot4", "request", {"kind": "environment", "position": (0.0, 0.0)}, 500.0)
+    info.receive("Robot4", "assigned", {"job_id": 3, "explorer": "Robot4", "environment": 2}, 501.0)
+    info.receive("Robot4", "request", {"kind": "path", "position": (0.0, 0.0)}, 550.0)
+    assert info.status[2] == "assigned" and info.records["Robot4"].environment == 2
