@@ -259,7 +259,11 @@ class PushEnd:
         p = self.params
         side = OPPOSITE[self.end]
         reading = obs.ir_range[self.side_ir[side]]
-        alongside = math.isfinite(reading) and not (self.seen and reading > p.follow_distance + p.face_lost)
+        # Only a reading within the band sees the face: a first one beyond it (backed off too far) steers towards the
+        # face but, counted as seen, was lost on the next tick, 4 cm along a 1.5 m face; the robot backed in past
+        # the far end and lost the box for good (kill:red@63.7, seed 106; 105 and 152 alike).
+        near = math.isfinite(reading) and reading <= p.follow_distance + p.face_lost
+        alongside = near or (math.isfinite(reading) and not self.seen)
         if min(obs.ir_range[self.tips]) < p.block_range:
             if not (self.seen or alongside) and self.stepped_out < p.step_outs:  # the box's own end ahead
                 self.stepped_out += 1
@@ -274,7 +278,7 @@ class PushEnd:
             # Steer for a heading along the box bent towards it (or away) by the distance error, at most
             # follow_bend: steering on the error alone turned the robot into the face, where the oblique ray reads
             # long and asks for more turn (a robot wedged itself against the box for 60 s, seed 100).
-            self.seen, self.lost_at = True, None
+            self.seen, self.lost_at = self.seen or near, None
             towards = -1.0 if side == RIGHT else 1.0
             bend = towards * float(np.clip(p.follow_gain * (reading - p.follow_distance), -p.follow_bend,
                                            p.follow_bend))

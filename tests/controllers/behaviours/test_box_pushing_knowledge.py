@@ -213,6 +213,33 @@ def test_a_side_reading_jumping_past_face_lost_is_the_end_of_the_box():
     assert states[-1] == "back_in"
 
 
+def test_a_first_side_reading_beyond_the_band_steers_in_but_does_not_see_the_face():
+    """Backed off 0.19 m instead of 0.12 m, a lone R-2 turned along the box with its side IR at 0.239 m, just past
+    follow_distance + face_lost: counted as the face seen and, on the next tick, lost, it backed in past the box's
+    far end and never found the box again (kill:red@63.7, seed 106: 0.74 m at 1800 s). Such a reading steers it
+    towards the face without seeing it; a reading within the band sees it, and the face is then lost as before."""
+    params = BoxPushParams()
+    push, estimate, station = following(params)
+    side = ROBOT.ir_sensors.index("ir_left_front")
+    band = params.follow_distance + params.face_lost
+
+    def step(t, reading):
+        obs = follow_observation(t, (math.inf, math.inf))
+        obs.ir_range[side] = reading
+        estimate.update(obs)
+        if push.mark is None:
+            push.state, push.since, push.mark = "follow", t, (t, estimate.pose.copy())
+        return push(obs)
+
+    commands = [step(0.1 * k, band + 0.009) for k in range(10)]
+    assert push.state == "follow" and not push.seen
+    assert all(c.omega > 0 for c in commands[1:])  # the face is on its left: it turns towards it
+    step(1.0, params.follow_distance)
+    assert push.seen
+    states = [(step(1.0 + 0.1 * k, band + 0.03), push.state)[1] for k in range(1, 6)]
+    assert states[-1] == "back_in"
+
+
 def test_an_acquisition_blocked_along_the_box_pushes_the_end_from_there():
     """Something in the fingertips' way while following the box, with no teammate heard (a teammate killed at
     that end, §6.1.2's failure without the seizure), ends the following: the R-2 backs off a little, turns into
