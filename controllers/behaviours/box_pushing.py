@@ -261,7 +261,7 @@ class PushEnd:
         reading = obs.ir_range[self.side_ir[side]]
         # Only a reading within the band sees the face: a first one beyond it (backed off too far) steers towards the
         # face but, counted as seen, was lost on the next tick, 4 cm along a 1.5 m face; the robot backed in past
-        # the far end and lost the box for good (kill:red@63.7, seed 106; 105, 152, 154, 160 and 164 alike).
+        # the far end and lost the box for good (kill:red@63.7, seed 106; 105 and 152 alike).
         near = math.isfinite(reading) and reading <= p.follow_distance + p.face_lost
         alongside = near or (math.isfinite(reading) and not self.seen)
         if min(obs.ir_range[self.tips]) < p.block_range:
