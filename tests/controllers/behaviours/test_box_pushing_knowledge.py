@@ -191,13 +191,10 @@ def test_the_push_heading_is_taken_from_the_compass_only_when_square_to_the_face
     assert station.heading == pytest.approx(-math.pi / 2 if keeps else -math.pi / 2 - 0.3)
 
 
-def test_a_side_reading_jumping_past_face_lost_is_the_end_of_the_box():
-    """Following the face at 0.11-0.14 m, the side IR read 0.24-0.28 m just past the box's end (the ray reaching
-    round the corner to the end face); steering in on that, a robot wrapped round the end and turned in 0.17 m
-    beyond it (kill:green@34.8, seed 10). A reading that far past follow_distance ends the face: the robot drives
-    end_overrun on and backs in."""
-    params = BoxPushParams()
-    push, estimate, station = following(params)
+def side_reading_follower(params: BoxPushParams):
+    """An R-2 following the box's face, and ``step(t, reading)``: one control tick with its left side IR at
+    ``reading`` (its command)."""
+    push, estimate, _ = following(params)
     side = ROBOT.ir_sensors.index("ir_left_front")
 
     def step(t, reading):
@@ -207,6 +204,17 @@ def test_a_side_reading_jumping_past_face_lost_is_the_end_of_the_box():
         if push.mark is None:
             push.state, push.since, push.mark = "follow", t, (t, estimate.pose.copy())
         return push(obs)
+
+    return push, step
+
+
+def test_a_side_reading_jumping_past_face_lost_is_the_end_of_the_box():
+    """Following the face at 0.11-0.14 m, the side IR read 0.24-0.28 m just past the box's end (the ray reaching
+    round the corner to the end face); steering in on that, a robot wrapped round the end and turned in 0.17 m
+    beyond it (kill:green@34.8, seed 10). A reading that far past follow_distance ends the face: the robot drives
+    end_overrun on and backs in."""
+    params = BoxPushParams()
+    push, step = side_reading_follower(params)
 
     step(0.0, 0.13)
     states = [(step(0.1 * k, params.follow_distance + params.face_lost + 0.03), push.state)[1] for k in range(1, 6)]
@@ -219,17 +227,8 @@ def test_a_first_side_reading_beyond_the_band_steers_in_but_does_not_see_the_fac
     far end and never found the box again (kill:red@63.7, seed 106: 0.74 m at 1800 s). Such a reading steers it
     towards the face without seeing it; a reading within the band sees it, and the face is then lost as before."""
     params = BoxPushParams()
-    push, estimate, station = following(params)
-    side = ROBOT.ir_sensors.index("ir_left_front")
+    push, step = side_reading_follower(params)
     band = params.follow_distance + params.face_lost
-
-    def step(t, reading):
-        obs = follow_observation(t, (math.inf, math.inf))
-        obs.ir_range[side] = reading
-        estimate.update(obs)
-        if push.mark is None:
-            push.state, push.since, push.mark = "follow", t, (t, estimate.pose.copy())
-        return push(obs)
 
     commands = [step(0.1 * k, band + 0.009) for k in range(10)]
     assert push.state == "follow" and not push.seen
