@@ -1,0 +1,158 @@
+"""The explorer (Chand §6.2): persistent poor progress on the way (a new path, then a new environment), an
+inaccessible waypoint skipped, and the bog rules: a wheeled explorer reports, backs out, resets what it mapped
+inside the bog and asks for a dry environment; a tracked one reports and drives on. Driven tick by tick with
+hand-made observations: the pose is whatever the test says, so the robot is stuck or bogged exactly when wanted."""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from teamsim.controllers.base import Observation
+from teamsim.controllers.exploration.explorer import Explorer
+from teamsim.controllers.exploration.territory import Territory
+from teamsim.controllers.navigation.dynamic_window import HRDU
+from teamsim.models.robot import DriveLimits
+from teamsim.positioning import PoseFix
+
+LIMITS = DriveLimits(v_max=0.4, omega_max=math.pi / 7, accel_max=0.2, angular_accel_max=0.3)
+BEARINGS = np.linspace(-math.pi, math.pi, 12, endpoint=False)
+TICK = 0.1
+
+
+def explorer(bog_capable: bool) -> Explorer:
+    territory = Territory(19.2, 0.3, 2)  # four environments of 9.6 m; 0 is south-west, 1 south-east
+    navigator = HRDU(LIMITS, "diffdrive", 0.35, (0.0, 0.0), grid=territory.unexplored_map())
+    return Explorer("Robot2", territory, navigator, manager="Robot3", bog_capable=bog_capable, radius=0.35)
+
+
+def observe(time: float, pose, velocity=(0.0, 0.0), effort=0.0) -> Observation:
+    ranges = np.full(len(BEARINGS), np.inf)  # nothing in sight: the ring maps free space round the robot
+    return Observation(time=time, robot="Robot2", ir_raw=ranges, ir_range=ranges, ir_bearings=BEARINGS,
+                       pose=PoseFix(*pose, time), velocity=velocity, drive_effort=effort)
+
+
+def sent(robot: Explorer, kind: str) -> list[dict]:
+    return [p.payload for p in robot.outbox if p.kind == kind]
+
+
+def assigned(robot: Explorer, environment: int, start=(-7.0, -4.8, 0.0)) -> float:
+    """The robot asks at ``start``, then gets the planner's straight path to ``environment``'s centre; returns the
+    time."""
+    robot.step(observe(0.0, start))
+    assert sent(robot, "request")[0]["kind"] == "environment" and robot.state == "wait"
+    robot.receive("plan", {"environment": environment, "path": np.array([start[:2], robot.territory.centre(
+        environment)])}, 100)
+    assert robot.state == "travel"
+    return TICK
+
+
+def test_persistent_poor_progress_on_the_way_asks_for_a_new_path_then_a_new_environment():
+    robot = explorer(bog_capable=False)
+    give_up = robot.params.give_up
+    t = assigned(robot, 1)
+    stand = (-7.0, -4.8, 0.0)
+    while t < give_up - 1.0:  # standing still, not yet persistent
+        robot.step(observe(t, stand))
+        t += TICK
+    assert robot.state == "travel" and len(sent(robot, "request")) == 1
+    while robot.state == "travel":
+        robot.step(observe(t, stand))
+        t += TICK
+    first = sent(robot, "request")[-1]
+    assert first["kind"] == "path" and first["give_up"] == 1 and t < give_up + 1.0
+    robot.receive("plan", {"environment": 1, "path": np.array([stand[:2], robot.territory.centre(1)])}, 100)
+    start = t
+    while robot.state == "travel":
+        robot.step(observe(t, stand))
+        t += TICK
+    second = sent(robot, "request")[-1]
+    assert second["kind"] == "environment" and second["give_up"] == 1
+    assert t - start >= give_up - TICK  # the second request waited its own give-up time
+
+
+def test_an_inaccessible_or_occupied_waypoint_is_skipped():
+    robot = explorer(bog_capable=False)
+    centre = robot.territory.centre(0)
+    robot.step(observe(0.0, (*centre, 0.0)))  # a request
+    robot.receive("plan", {"environment": 0, "path": np.zeros((0, 2))}, 0)
+    robot.step(observe(TICK, (*centre, 0.0)))  # at the centre: arrived, the coverage waypoints are made
+    assert robot.state == "explore" and robot.waypoints
+    goal, rest = robot.nav.goal, list(robot.waypoints)
+    t = 2 * TICK
+    while robot.nav.goal == goal:  # no progress towards it: after ``give_up`` s it is given up
+        robot.step(observe(t, (*centre, 0.0)))
+        t += TICK
+    assert robot.params.give_up - TICK <= t <= robot.params.give_up + 1.0
+    assert robot.nav.goal == rest[0] and robot.waypoints == rest[1:]
+    row, col = robot.territory.cell_of(*rest[1])  # the next one turns out to lie in an obstacle
+    robot.nav.grid.probabilities[row, col] = 0.95
+    robot._next_waypoint(t)
+    assert robot.nav.goal == rest[2] and robot.waypoints == rest[3:]
+
+
+def drive_into_bog(robot: Explorer, t: float, x_bog: float = -5.0) -> tuple[float, float]:
+    """East along y = -4.8 at 0.3 m/s to ``x_bog``, then creeping at 0.01 m/s with high effort (a bog) until the
+    explorer reacts; returns (time, x)."""
+    x = -7.0
+    while robot.state == "travel":
+        boggy = x >= x_bog
+        speed = 0.01 if boggy else 0.3
+        robot.step(observe(t, (x, -4.8, 0.0), velocity=(speed, 0.0), effort=0.6 if boggy else 0.05))
+        x += speed * TICK
+        t += TICK
+        if t > 30.0 or sent(robot, "bog"):
+            break
+    return t, x
+
+
+def test_a_wheeled_explorer_backs_out_of_a_bog_resets_what_it_mapped_in_it_and_asks_for_a_dry_environment():
+    robot = explorer(bog_capable=False)
+    t, x = drive_into_bog(robot, assigned(robot, 1))
+    report = sent(robot, "bog")
+    assert report and report[0]["environment"] == 0 and robot.state == "back-out"
+    target = robot.bog.first_node
+    assert math.dist(target, (x - robot.params.back_out_distance, -4.8)) < 0.3  # its own trail, 2 m back
+    v, omega, behaviour = robot.step(observe(t, (x, -4.8, 0.0), velocity=(0.01, 0.0), effort=0.6))
+    assert v < 0 and behaviour == "explorer: back out of bog"
+    mapped_in_bog = list(robot.bog.mapped_from)
+    robot.step(observe(t + TICK, (*target, 0.0), velocity=(-0.2, 0.0)))  # out, at the point before the bog
+    reset = sent(robot, "reset")[0]
+    assert len(reset["rows"]) > 0
+    assert np.all(robot.nav.grid.probabilities[reset["rows"], reset["cols"]] == 0.5)
+    for bx, by in mapped_in_bog:  # every cell round where it stood in the bog is unexplored again
+        assert robot.territory.cell_of(bx, by) in set(zip(reset["rows"].tolist(), reset["cols"].tolist()))
+    request = sent(robot, "request")[-1]
+    assert request == {"kind": "environment", "position": mapped_in_bog[-1], "bog_capable": False, "give_up": 1,
+                       "bog": True}
+    assert robot.state == "wait" and robot.assignment is None
+
+
+def test_the_bog_sign_takes_bog_time_of_slow_hard_driving():
+    robot = explorer(bog_capable=False)
+    t = assigned(robot, 1)
+    start = None
+    x = -7.0
+    while not sent(robot, "bog"):
+        robot.step(observe(t, (x, -4.8, 0.0), velocity=(0.01, 0.0), effort=0.6))
+        start = t if start is None else start
+        x += 0.001
+        t += TICK
+    assert abs((t - TICK) - start - robot.params.bog_time) < TICK + 1e-9
+    # hard driving while turning (a skid turn) or while stalled (v = 0, against a box) is no bog
+    for velocity in ((0.01, 0.3), (0.0, 0.0)):
+        other = explorer(bog_capable=False)
+        t = assigned(other, 1)
+        for _ in range(40):
+            other.step(observe(t, (-7.0, -4.8, 0.0), velocity=velocity, effort=0.6))
+            t += TICK
+        assert not sent(other, "bog") and other.state == "travel"
+
+
+def test_a_tracked_explorer_reports_a_bog_and_drives_on():
+    robot = explorer(bog_capable=True)
+    t, x = drive_into_bog(robot, assigned(robot, 1))
+    assert sent(robot, "bog")[0]["environment"] == 0
+    v, omega, behaviour = robot.step(observe(t, (x, -4.8, 0.0), velocity=(0.01, 0.0), effort=0.6))
+    assert robot.state == "travel" and behaviour == "explorer: travel E1" and v >= 0.0
+    assert not sent(robot, "reset") and len(sent(robot, "request")) == 1

@@ -1,0 +1,104 @@
+"""The planner (Chand §6.3): the two-tiered A* path to an environment keeps out of environments assigned to other
+explorers and, for a wheeled explorer only, out of boggy ones; two planners settle a contested environment by
+distributed mutual exclusion, the loser proposing again without it."""
+from __future__ import annotations
+
+import numpy as np
+
+from teamsim.controllers.exploration.assignment import ExplorerState
+from teamsim.controllers.exploration.planner import Planner
+from teamsim.controllers.exploration.territory import Territory
+
+TERRITORY = Territory(28.8, 0.3, 3)  # nine environments of 9.6 m
+WEST, MIDDLE, EAST = (TERRITORY.environment_of(x, -9.6) for x in (-9.6, 0.0, 9.6))  # the southern row
+NORTH_MIDDLE = TERRITORY.environment_of(0.0, 0.0)
+
+
+def path_job(explorer: ExplorerState, environment: int, boggy=()) -> dict:
+    return {"job_id": 1, "kind": "path", "explorer": explorer, "environment": environment, "radius": 0.35,
+            "global_map": np.full((TERRITORY.cells, TERRITORY.cells), 0.5), "bog_points": [],
+            "boggy": [e in boggy for e in range(TERRITORY.environments)]}
+
+
+def planned_path(planner: Planner, job: dict) -> np.ndarray:
+    planner.receive("job", job, 100)
+    planner.step(0.0)
+    planner.step(60.0)  # past the map fetches' transmission time
+    return [p for p in planner.outbox if p.kind == "plan"][-1].payload["path"]
+
+
+def environments_crossed(path: np.ndarray) -> set[int]:
+    return {TERRITORY.environment_of(x, y) for x, y in path}
+
+
+def test_a_path_goes_round_an_environment_assigned_to_another_explorer():
+    explorer = ExplorerState("Robot2", TERRITORY.centre(WEST), 1.0, False, WEST)
+    free = planned_path(Planner("Robot4", TERRITORY, manager="Robot3"), path_job(explorer, EAST))
+    assert MIDDLE in environments_crossed(free)  # the straight way east
+    planner = Planner("Robot4", TERRITORY, manager="Robot3")
+    planner.receive("assigned", {"environment": MIDDLE, "explorer": "Robot5"}, 100)
+    around = planned_path(planner, path_job(explorer, EAST))
+    assert MIDDLE not in environments_crossed(around) and NORTH_MIDDLE in environments_crossed(around)
+    assert np.allclose(around[-1], TERRITORY.centre(EAST), atol=TERRITORY.resolution)
+
+
+def test_a_wheeled_explorer_is_routed_round_a_boggy_environment_and_a_tracked_one_through_it():
+    wheeled = ExplorerState("Robot2", TERRITORY.centre(WEST), 1.0, False, WEST)
+    tracked = ExplorerState("Robot4", TERRITORY.centre(WEST), 1.0, True, WEST)
+    around = planned_path(Planner("Robot4", TERRITORY, manager="Robot3"), path_job(wheeled, EAST, boggy={MIDDLE}))
+    through = planned_path(Planner("Robot4", TERRITORY, manager="Robot3"), path_job(tracked, EAST, boggy={MIDDLE}))
+    assert MIDDLE not in environments_crossed(around)
+    assert MIDDLE in environments_crossed(through)
+
+
+def assignment_job(job_id: int, explorer: ExplorerState, other: ExplorerState, status: list[str]) -> dict:
+    return {"job_id": job_id, "kind": "environment", "explorer": explorer, "others": [other],
+            "environment": None, "radius": 0.35, "status": status, "boggy": [False] * len(status),
+            "bog_points": [], "excluded": set(), "global_map": np.full((TERRITORY.cells, TERRITORY.cells), 0.5),
+            "unexplored": [1.0] * len(status), "t_m": 60.0, "ect": {}}
+
+
+def negotiate(planners: dict[str, Planner], until: float) -> tuple[list, list[dict]]:
+    """Step the planners every 0.1 s, delivering each one's broadcasts to the others; the proposals and the
+    assignments made."""
+    proposals, assignments = [], []
+    for tick in range(round(until / 0.1)):
+        for name, planner in planners.items():
+            planner.step(tick * 0.1)
+        for name, planner in planners.items():
+            for packet in planner.outbox:
+                if packet.to is None:  # a broadcast: to the other planners (and the manager)
+                    for other_name, other in planners.items():
+                        if other_name != name:
+                            other.receive(packet.kind, packet.payload, packet.size)
+                if packet.kind == "propose":
+                    proposals.append(packet.payload["proposal"])
+                if packet.kind == "assigned":
+                    assignments.append(packet.payload)
+            planner.outbox.clear()
+    return proposals, assignments
+
+
+def test_two_planners_proposing_one_environment_settle_it_by_the_lowest_job_id_at_equal_trade_offs():
+    """Two explorers on either side of the only two open environments' line, each the same distance from both:
+    both planners propose the same one at the same trade-off; job 1 gets it and the other planner's explorer the
+    other environment, after a second round."""
+    status = ["E"] * TERRITORY.environments
+    status[MIDDLE] = status[NORTH_MIDDLE] = "UE"
+    west = ExplorerState("Robot2", (-4.8, -4.8), 1.0, False, WEST)
+    east = ExplorerState("Robot5", (4.8, -4.8), 1.0, False, EAST)
+    planners = {"Robot4": Planner("Robot4", TERRITORY, manager="Robot3"),
+                "Robot6": Planner("Robot6", TERRITORY, manager="Robot3")}
+    planners["Robot4"].receive("job", assignment_job(2, west, east, status), 100)
+    planners["Robot6"].receive("job", assignment_job(1, east, west, status), 100)
+    proposals, assignments = negotiate(planners, until=3.0)
+    first_round = sorted(proposals[:2], key=lambda p: p.job_id)
+    assert first_round[0].environment == first_round[1].environment
+    assert first_round[0].tradeoff == first_round[1].tradeoff
+    by_explorer = {a["explorer"]: (a["environment"], a["job_id"]) for a in assignments}
+    assert len(assignments) == 2 and len({env for env, _ in by_explorer.values()}) == 2
+    contested = first_round[0].environment
+    assert by_explorer["Robot5"][0] == contested  # job 1 won it
+    assert by_explorer["Robot2"][0] == ({MIDDLE, NORTH_MIDDLE} - {contested}).pop()
+    for planner in planners.values():
+        assert planner.taken == {env: name for name, (env, _) in by_explorer.items()}
