@@ -29,5 +29,7 @@ class Scene:
     info: dict = field(default_factory=dict)  # whatever else the mission needs later (goal, known map, ...)
     faults: list = field(default_factory=list)  # teamsim.faults.Fault the scenario starts with (a dead sensor, ...)
     scenario: Any = None  # the teamsim.scenario.Scenario it was built from, if the mission describes worlds so
-    # Robot -> (bandwidth bit/s, range m): the team talks over teamsim.network (Chand's 802.11) instead of the radio
+    # Robot -> (bandwidth bit/s, range m): the team talks over teamsim.network (Chand's 802.11) instead of the radio,
+    # with the latency and loss of ``network_config`` (a teamsim.network.NetworkConfig; None: its defaults)
     network: dict | None = None
+    network_config: Any = None

@@ -180,7 +180,8 @@ class World:
         self.model.opt.disableflags |= _SENSOR_STAGE
         self._index_model()
         radio_rngs = {n: self.streams.get("robot", n, "radio") for n in self.robots}
-        self.radio = (Network(NetworkConfig(), scene.network, radio_rngs) if scene.network is not None
+        self.radio = (Network(scene.network_config or NetworkConfig(), scene.network, radio_rngs)
+                      if scene.network is not None
                       else RadioBus(config.radio, radio_rngs))
         self.positioning = PositioningService(config.positioning,
                                               {n: self.streams.get("robot", n, "positioning") for n in self.robots})

@@ -61,6 +61,7 @@ EXPECTED_PER_MINUTE = {
     "wheeled": {"speed": 0.5, "plan": [0.1584, 3.01], "comm": [8580.0], "sense": [382.0, 381.0], "act": [18.27]},
 }
 PLANNER_PER_MINUTE = {"plan": [0.442, 0.442], "comm": [10380.0]}  # Robot4 on W1, Table 5.31
+NETWORK = NetworkConfig()  # the link's defaults: 5 ms latency, no loss
 MAPPING = MappingParams(hit_cell="beyond")  # cells occupied when their centre is, as the true raster counts
 # Table 8.1's levels: none (level 1), task scores only (level 2), the whole feedback coordination (level 3)
 FEEDBACK_MODES = ("full", "scores", "none")  # not on/off: YAML would read those as booleans
@@ -93,6 +94,9 @@ class ExploreParams:
     poor: str = setting("table", choices=("table", *POOR_THRESHOLDS), meaning="the explorers' OTES_T (Table 8.1)")
     partial: str = setting("table", choices=("table", *PARTIAL_THRESHOLDS),
                            meaning="the explorers' TES_T (Table 8.1)")
+    latency: float = setting(NETWORK.latency, lo=0.0, hi=60.0,
+                             meaning="802.11 delay after a packet's last byte is on air, s (not given)")
+    loss: float = setting(NETWORK.loss, lo=0.0, hi=1.0, meaning="probability a packet is lost, per receiver")
 
     def team_sizes(self) -> tuple[int, int]:
         match = TEAM_FORM.match(self.team.strip())
@@ -131,6 +135,11 @@ class ExploreTask:
     weights: str = setting("table", choices=("table", *WEIGHT_SETS), meaning="the explorers' WS")
     poor: str = setting("table", choices=("table", *POOR_THRESHOLDS), meaning="the explorers' OTES_T")
     partial: str = setting("table", choices=("table", *PARTIAL_THRESHOLDS), meaning="the explorers' TES_T")
+    latency: float = setting(NETWORK.latency, lo=0.0, hi=60.0, meaning="802.11 delay after the last byte, s")
+    loss: float = setting(NETWORK.loss, lo=0.0, hi=1.0, meaning="probability a packet is lost, per receiver")
+
+    def network_config(self) -> NetworkConfig:
+        return dataclasses.replace(NETWORK, latency=self.latency, loss=self.loss)
 
 
 @dataclass
@@ -213,7 +222,7 @@ class ExploreMission(ScenarioMission):
                             planners=planners, explorers=explorers, divisions=params.divisions,
                             resolution=params.resolution, t_m=params.t_m, explored_threshold=params.explored_threshold,
                             backend=params.backend, feedback=params.feedback, weights=params.weights,
-                            poor=params.poor, partial=params.partial))
+                            poor=params.poor, partial=params.partial, latency=params.latency, loss=params.loss))
 
     def duration_of(self, params: ExploreParams) -> float:
         """MET for the team (§8.2): 15000 s for one explorer, 5000 s for more."""
@@ -231,6 +240,7 @@ class ExploreMission(ScenarioMission):
         scene = scene_of(scenario, newcomers, physics_dt)
         specs = {r.id: r for r in load_robots()}
         scene.network = {name: (specs[name].bandwidth * 1e6, specs[name].comm_range) for name in scenario.robots}
+        scene.network_config = scenario.task.network_config()
         scene.info.update(team_setup(scenario))
         return scene
 
@@ -482,7 +492,8 @@ def kinematic_team(scenario: Scenario, seed: int, faults=()) -> tuple[KinematicT
         members[name] = Member(KinematicBody(kinematic_robot(model), entry.pose), team_controller(name, model, info),
                                model.traversability)
     specs = info["specs"]
-    network = Network(NetworkConfig(), {n: (specs[n].bandwidth * 1e6, specs[n].comm_range) for n in members},
+    network = Network(scenario.task.network_config(),
+                      {n: (specs[n].bandwidth * 1e6, specs[n].comm_range) for n in members},
                       {n: streams.get("robot", n, "radio") for n in members})
     world = nav_world_of(dataclasses.replace(scenario, task=_RasterTask(scenario.task.resolution)))
     return KinematicTeam(world, scenario.arena.bogs, members, network, list(faults)), info

@@ -16,8 +16,10 @@ from teamsim.cli import main
 from teamsim.config import ConfigError, TrialConfig
 from teamsim.faults import parse_fault
 from teamsim.runner import run_trial
-from teamsim.tasks.missions.explore import (ExploreParams, ExploreTask, explorer_feedback, kinematic_trial,
-                                           role_names, team_allocation)
+from teamsim.scenario import resolve
+from teamsim.tasks.missions.explore import (ExploreMission, ExploreParams, ExploreTask, explorer_feedback,
+                                           kinematic_trial, role_names, team_allocation)
+from teamsim.world import World
 
 SMALL = dict(size=19.2, divisions=2, t_m=30.0)  # four 9.6 m environments; feedback every 30 s
 
@@ -149,6 +151,21 @@ def test_params_check_names_the_field():
         ExploreParams(team="one three").check()
 
 
+def first_assignment(latency: float, loss: float) -> float | None:
+    params = ExploreParams(team="1 2", bog_share=0.0, latency=latency, loss=loss, **SMALL)
+    run = kinematic_trial(TrialConfig(mission="explore", params=params, seed=2), duration=40.0)
+    assigned = events(run, "assigned")
+    return assigned[0]["t"] if assigned else None
+
+
+def test_the_network_s_latency_and_loss_are_settings():
+    """§6.5's 802.11 link: a request, a job and an assignment each cross it, so 2 s of latency delays the first
+    assignment by at least that; with every packet lost no request reaches the manager and nothing is assigned."""
+    prompt = first_assignment(0.005, 0.0)
+    assert prompt is not None and first_assignment(2.0, 0.0) >= prompt + 2.0
+    assert first_assignment(0.005, 1.0) is None
+
+
 # -- physics ------------------------------------------------------------------------------------------------------
 def test_physics_runs_the_same_controllers_and_maps(tmp_path):
     """A short physics run of the small world: the roles start, explorers are sent out and map through MuJoCo's
@@ -161,3 +178,10 @@ def test_physics_runs_the_same_controllers_and_maps(tmp_path):
     assert len(events({"metrics": metrics}, "assigned")) >= 2
     assert metrics["explored_share"] > 0.15 and metrics["map_accuracy"] >= 0.9
     assert all((result.run_dir / f"{name}.{kind}").exists() for name in ("map", "coverage") for kind in ("png", "svg"))
+
+
+def test_the_physics_world_talks_over_the_scenario_s_network():
+    params = ExploreParams(team="1 2", bog_share=0.0, latency=0.25, loss=0.1, **SMALL)
+    config = resolve(TrialConfig(mission="explore", params=params, seed=2), ExploreMission())
+    network = World(config, ExploreMission()).radio
+    assert (network.config.latency, network.config.loss) == (0.25, 0.1)
