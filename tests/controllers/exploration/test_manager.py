@@ -68,3 +68,24 @@ def test_a_request_for_an_environment_releases_one_the_explorer_never_took_up():
     info.receive("Robot4", "assigned", {"job_id": 3, "explorer": "Robot4", "environment": 2}, 501.0)
     info.receive("Robot4", "request", {"kind": "path", "position": (0.0, 0.0)}, 550.0)
     assert info.status[2] == "assigned" and info.records["Robot4"].environment == 2
+
+
+def test_the_terrain_map_marks_a_reported_bog_s_environment_and_keeps_the_spot_for_the_planners():
+    """§6.1/§6.2.2: a bog report marks its whole environment boggy (once) and keeps the point; the cells a wheeled
+    explorer mapped from inside the bog are reset to unexplored; the next job carries both to the planner."""
+    info = manager(["Robot4", "Robot2"])
+    info.bog_capable, info.radii, info.rates = {"Robot4": True, "Robot2": False}, \
+        {"Robot4": 0.6, "Robot2": 0.5}, {"Robot4": 1.0, "Robot2": 1.0}
+    info.global_map[10:14, 10:14] = 0.1
+    info.receive("Robot2", "bog", {"environment": 0, "position": (-6.0, -6.0)}, 50.0)
+    info.receive("Robot4", "bog", {"environment": 0, "position": (-5.0, -6.0)}, 60.0)
+    assert info.boggy == [True, False, False, False]
+    assert info.bog_points == [(-6.0, -6.0), (-5.0, -6.0)]
+    assert [(e["robot"], e["environment"]) for e in info.log if e["event"] == "bog"] == [("Robot2", 0)]
+    info.receive("Robot2", "reset", {"rows": [10, 11], "cols": [10, 12]}, 61.0)
+    assert info.global_map[10, 10] == info.global_map[11, 12] == 0.5 and info.global_map[10, 11] == 0.1
+    info.receive("Robot2", "request", {"kind": "environment", "position": (-8.0, -8.0)}, 62.0)
+    info.step(62.0)
+    job = [p.payload for p in info.outbox if p.kind == "job"][0]
+    assert job["boggy"] == [True, False, False, False] and job["bog_points"] == info.bog_points
+    assert job["explorer"].bog_capable is False

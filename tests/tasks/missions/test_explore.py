@@ -10,15 +10,18 @@ from __future__ import annotations
 
 import functools
 
+import numpy as np
 import pytest
 
 from teamsim.cli import main
 from teamsim.config import ConfigError, TrialConfig
+from teamsim.controllers.exploration.manager import FeedbackSystem, GlobalInfo
+from teamsim.controllers.exploration.territory import Territory
 from teamsim.faults import parse_fault
 from teamsim.runner import run_trial
 from teamsim.scenario import resolve
-from teamsim.tasks.missions.explore import (ExploreMission, ExploreParams, ExploreTask, explorer_feedback,
-                                           kinematic_trial, role_names, team_allocation)
+from teamsim.tasks.missions.explore import (ExploreMission, ExploreParams, ExploreTask, exploration_outcome,
+                                           explorer_feedback, kinematic_trial, role_names, team_allocation)
 from teamsim.world import World
 
 SMALL = dict(size=19.2, divisions=2, t_m=30.0)  # four 9.6 m environments; feedback every 30 s
@@ -149,6 +152,35 @@ def test_bad_input_is_one_line_and_exit_2(capsys, tmp_path, argv, fragment):
 def test_params_check_names_the_field():
     with pytest.raises(ConfigError, match="team="):
         ExploreParams(team="one three").check()
+
+
+def test_the_measures_on_a_hand_made_map():
+    """§8.1's PAE, ET and ER = PAE / ET (8.1), and map accuracy, on a map worked by hand: environment 0 all mapped
+    (one 2 x 2 box right, one free cell wrongly marked occupied), environment 1 mapped on its western half only,
+    the other two not at all; environment 3 reported boggy."""
+    territory = Territory(19.2, 0.3, 2)
+    manager = GlobalInfo("Robot3", territory, explorers=[], planners=[], task_scores={}, bog_capable={}, radii={},
+                         rates={}, t_m=60.0)
+    truth = np.zeros((territory.cells, territory.cells), bool)
+    rows, cols = territory.slices(0)
+    manager.global_map[rows, cols] = 0.05
+    truth[rows.start + 10:rows.start + 12, cols.start + 10:cols.start + 12] = True
+    manager.global_map[rows.start + 10:rows.start + 12, cols.start + 10:cols.start + 12] = 0.95
+    manager.global_map[rows.start + 20, cols.start + 20] = 0.95
+    rows, cols = territory.slices(1)
+    manager.global_map[rows, cols.start:cols.start + territory.environment_cells // 2] = 0.05
+    manager.boggy[3] = True
+    info = {"territory": territory, "truth": truth, "bogs": [],
+            "team": {"global_info": manager, "feedback": FeedbackSystem("Robot1", None, 60.0), "robots": {}}}
+    completed, metrics = exploration_outcome(info, 400.0)
+    assert completed  # no explorer left working, none assigned
+    assert metrics["explored_cells"] == 1024 + 512
+    assert metrics["explored_share"] == pytest.approx((1.0 + 0.5 + 0 + 0) / 4)
+    assert metrics["exploration_time"] == 400.0
+    assert metrics["exploration_rate"] == pytest.approx(0.375 / 400.0)
+    assert metrics["map_accuracy"] == pytest.approx(round((1536 - 1) / 1536, 4))
+    assert metrics["bogs_found"] == [3] and metrics["boggy_environments"] == []
+    assert metrics["status"] == {"UE": 4, "assigned": 0, "PE": 0, "E": 0}  # (graded when explorers report)
 
 
 def first_assignment(latency: float, loss: float) -> float | None:
