@@ -9,6 +9,7 @@ work passes to another robot; a broken motor is a partial failure; and bad input
 from __future__ import annotations
 
 import functools
+import math
 
 import numpy as np
 import pytest
@@ -210,6 +211,24 @@ def test_physics_runs_the_same_controllers_and_maps(tmp_path):
     assert len(events({"metrics": metrics}, "assigned")) >= 2
     assert metrics["explored_share"] > 0.15 and metrics["map_accuracy"] >= 0.9
     assert all((result.run_dir / f"{name}.{kind}").exists() for name in ("map", "coverage") for kind in ("png", "svg"))
+
+
+def test_the_video_panel_shows_the_manager_s_map_as_it_grows():
+    """The video's second panel: the manager's global map with a HUD of roles, redrawn once per period; newly
+    mapped cells change its pixels."""
+    params = ExploreParams(team="1 2", bog_share=0.0, **SMALL)
+    mission = ExploreMission()
+    world = World(resolve(TrialConfig(mission="explore", params=params, seed=2), mission), mission)
+    world.tick()  # the robots take up their roles
+    before = mission.video_panel(world)
+    assert before.dtype == np.uint8 and before.ndim == 3 and before.shape[2] == 3
+    assert mission.video_panel(world) is None  # within the period: keep the last one
+    info = world.scene.info
+    rows, cols = info["territory"].slices(0)
+    info["team"]["global_info"].global_map[rows, cols] = 0.05  # environment 0 mapped free
+    info["panel_time"] = -math.inf
+    after = mission.video_panel(world)
+    assert after.shape == before.shape and np.count_nonzero(np.any(after != before, axis=2)) > 0.1 * after[..., 0].size
 
 
 def test_the_physics_world_talks_over_the_scenario_s_network():
