@@ -102,3 +102,23 @@ def test_two_planners_proposing_one_environment_settle_it_by_the_lowest_job_id_a
     assert by_explorer["Robot2"][0] == ({MIDDLE, NORTH_MIDDLE} - {contested}).pop()
     for planner in planners.values():
         assert planner.taken == {env: name for name, (env, _) in by_explorer.items()}
+
+
+def test_when_environments_run_short_a_slow_explorer_s_ect_is_not_acceptable():
+    """§6.4.3 with the manager's figures: one environment left for two explorers. (5.23) by each one's observed
+    rate (t > T_m): Robot2 explored 100 cells in 600 s and has 200 left where it is, ECT 600 (200 + 1024) / 100 =
+    7344 s; Robot5 explored 400 cells in 600 s with nothing left, ECT 600 x 1024 / 400 = 1536 s. Robot2 ranks second:
+    no environment for it; Robot5's proposal goes ahead."""
+    status = ["E"] * TERRITORY.environments
+    status[MIDDLE] = "UE"
+    west = ExplorerState("Robot2", (-4.8, -4.8), 1.0, False, WEST)
+    east = ExplorerState("Robot5", (4.8, -4.8), 1.0, False, EAST)
+    figures = {"Robot2": {"time": 600.0, "unexplored_current": 200.0, "explored": 100.0, "rate": 1.0},
+               "Robot5": {"time": 600.0, "unexplored_current": 0.0, "explored": 400.0, "rate": 1.0}}
+    for explorer, other, refused in ((west, east, True), (east, west, False)):
+        job = assignment_job(1, explorer, other, status) | {"ect": figures, "unexplored": [1024.0] * len(status)}
+        planner = Planner("Robot4", TERRITORY, manager="Robot3")
+        planner.receive("job", job, 100)
+        planner.step(0.0)
+        kinds = [p.kind for p in planner.outbox]
+        assert kinds == (["no-environment"] if refused else ["propose"])
