@@ -87,12 +87,14 @@ re-plans. Each is ``__call__(Observation) -> Command``. Between positioning fixe
 advances its last fix by its odometry (``Observation.velocity``; without one, by the velocities it commanded).
 It takes the dynamic window's state (v_c, omega_c) from its own last command, which the locomotion follows under
 the same acceleration limits, except when the odometry says the robot has stalled: driven at 0.05 m/s or more,
-it moved at under a quarter of that over the last period. Something the IR ring does not see, such as a box
-corner between two beams, is holding it. The controller then starts from the measured (rest) state and
-remembers a contact point on its circle where its centre was heading (``_contact``). Before this, a robot halted
-against such a corner went on asking for the same motion for the rest of the trial (a touch-lock). The 0.05 m/s
-and the quarter are choices, not the thesis's: setting off from rest, a physics robot lags its first commands by
-more than a quarter. The IR ring sees only a few directions (10-14 beams for
+it moved at under a quarter of that over the last period, and turned at under a quarter of its commanded turn rate
+(or of 0.2 rad/s: a robot that turns as asked is not held; a tracked robot turning in a bog creeps forward, and
+read as stalls its creeps left phantom contacts all round it that kept it spinning on the spot). Something the IR
+ring does not see, such as a box corner between two beams, is holding it. The controller then starts from the
+measured (rest) state and remembers a contact point on its circle where its centre was heading (``_contact``).
+Before this, a robot halted against such a corner went on asking for the same motion for the rest of the trial (a
+touch-lock). The 0.05 m/s, the 0.2 rad/s and the quarter are choices, not the thesis's: setting off from rest, a
+physics robot lags its first commands by more than a quarter. The IR ring sees only a few directions (10-14 beams for
 41 candidate directions), so a controller keeps the obstacle points of the last ``obstacle_memory`` seconds, in
 its odometry frame so that a fix's jump does not smear them. Eight seconds (a choice): a box corner that juts
 out between two beams is seen only from further off, and in the kinematic study Robot B met such corners about
@@ -127,6 +129,9 @@ INVALID = -1.0  # the objectives' "otherwise" value
 # A stall (module notes; both chosen): driven at least this fast, m/s, the odometry reads under this share of it.
 STALL_DRIVEN_SPEED = 0.05
 STALL_SPEED_SHARE = 0.25
+# ... and it turns at under this share of the commanded turn rate, or of this one (rad/s), whichever is more: a
+# robot that turns as asked is not held (a tracked robot turning in a bog creeps forward; chosen).
+STALL_TURN_FLOOR = 0.2
 NO_CONTACT = np.zeros((0, 2))  # obstacle points of no stall
 MEMORY_CELL = 0.02  # m: the obstacle memory keeps one point per square of this side
 
@@ -784,11 +789,13 @@ class DynamicWindowController:
 
     def _contact(self, commanded: DriveState, velocity) -> np.ndarray:
         """Where a stall says the body touches, relative to the pose's reference point in the robot frame: the
-        point of the enclosing circle the centre was moving towards, when the odometry shows the robot stopped
-        although it was driven (a touch the IR ring did not see, such as a box corner between two beams).
+        point of the enclosing circle the centre was moving towards, when the odometry shows the robot stopped, and
+        not turning as asked, although it was driven (a touch the IR ring did not see, such as a box corner between
+        two beams).
         Empty when there is no stall."""
         if (velocity is None or abs(commanded.v) < STALL_DRIVEN_SPEED
-                or abs(velocity[0]) > STALL_SPEED_SHARE * abs(commanded.v)):
+                or abs(velocity[0]) > STALL_SPEED_SHARE * abs(commanded.v)
+                or abs(velocity[1]) > STALL_SPEED_SHARE * max(abs(commanded.omega), STALL_TURN_FLOOR)):
             return NO_CONTACT
         bearing = math.atan2(commanded.omega * self.offset, commanded.v)
         return np.array([[self.offset + self.radius * math.cos(bearing), self.radius * math.sin(bearing)]])

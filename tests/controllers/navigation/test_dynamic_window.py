@@ -428,6 +428,12 @@ def test_a_stall_is_a_contact_on_the_circle_where_the_centre_was_heading():
     assert len(controller._contact(driven, (0.3, 0.1))) == 0  # moving: no stall
     assert len(controller._contact(DriveState(0.02, 0.0), (0.0, 0.0))) == 0  # setting off from rest lags
     assert len(controller._contact(driven, None)) == 0  # no odometry, no stall
+    # Turning as asked, it is not held (a tracked robot in a bog creeps forward while it turns): no stall ...
+    turning = DriveState(0.4, -0.45, 0.0)
+    assert len(controller._contact(turning, (0.05, -0.2))) == 0
+    # ... but hardly turning, whatever the command, it is (held straight by a wall, or turning slowly on a corner)
+    assert len(controller._contact(turning, (0.05, -0.1))) == 1
+    assert len(controller._contact(DriveState(0.4, 0.0, 0.0), (0.0, 0.04))) == 1
 
 
 def test_a_stalled_robot_starts_again_from_rest_and_not_into_what_stopped_it():
