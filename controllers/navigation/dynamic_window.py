@@ -88,9 +88,8 @@ advances its last fix by its odometry (``Observation.velocity``; without one, by
 It takes the dynamic window's state (v_c, omega_c) from its own last command, which the locomotion follows under
 the same acceleration limits, except when the odometry says the robot has stalled: driven at 0.05 m/s or more,
 it moved at under a quarter of that over the last period, and turned at under a quarter of its commanded turn rate
-(or of 0.2 rad/s: a robot that turns as asked is not held; a tracked robot turning in a bog creeps forward, and
-read as stalls its creeps left phantom contacts all round it that kept it spinning on the spot). Something the IR
-ring does not see, such as a box corner between two beams, is holding it. The controller then starts from the
+(or of 0.2 rad/s: a robot that turns as asked is not held, docs/decisions.md). Something the IR ring does not
+see, such as a box corner between two beams, is holding it. The controller then starts from the
 measured (rest) state and remembers a contact point on its circle where its centre was heading (``_contact``).
 Before this, a robot halted against such a corner went on asking for the same motion for the rest of the trial (a
 touch-lock). The 0.05 m/s, the 0.2 rad/s and the quarter are choices, not the thesis's: setting off from rest, a
