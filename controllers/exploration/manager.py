@@ -158,9 +158,9 @@ class GlobalInfo:
     def _on_roles(self, sender: str, payload: dict, now: float) -> None:
         """Feedback reallocated the workers: explorers and planners that left are faults (Fig 6.9)."""
         workers = payload["workers"]
-        for explorer in set(self.explorers) - set(workers.get(EXPLORER, [])):
+        for explorer in sorted(set(self.explorers) - set(workers.get(EXPLORER, []))):  # not a set's hash order
             self._explorer_fault(explorer, now)
-        for planner in set(self.planners) - set(workers.get(PLANNER, [])):
+        for planner in sorted(set(self.planners) - set(workers.get(PLANNER, []))):
             requeued = self.queue.requeue_planner(planner)
             self.busy.discard(planner)
             self.log.append({"t": now, "event": "planner removed", "robot": planner, "requeued": len(requeued)})
