@@ -109,7 +109,7 @@ class KinematicTeam:
     def _ranges(self, name: str, body: KinematicBody) -> np.ndarray:
         """IR ranges to the boxes and walls, and to the other live robots' enclosing circles."""
         origins, directions = body.rays()
-        ranges = body.ranges(self.world, (origins, directions))
+        ranges = body.ranges(self.world)
         cx, cy = body.centre(body.x, body.y, body.heading)
         # A circle farther than any ray reaches cannot be seen; the margin covers circle_ranges' rounding
         reach = body.robot.ir_range + float(body.sensor_radius.max()) + REACH_MARGIN
@@ -129,6 +129,8 @@ class KinematicTeam:
 
     def _bumps(self, name: str, body: KinematicBody, x: float, y: float, heading: float) -> bool:
         """The move would bring its enclosing circle closer into another live robot's."""
+        if (x, y, heading) == (body.x, body.y, body.heading):
+            return False  # standing still brings it closer to none
         after = body.centre(x, y, heading)
         before = body.centre(body.x, body.y, body.heading)
         for other, member in self.members.items():

@@ -279,18 +279,29 @@ def _ray_ranges(origins, directions, lo, hi, half, max_range):  # noqa: PLR0913
 
 
 def clearance(world: NavWorld, x: float, y: float) -> float:
-    """Distance from a point to the nearest box or wall. The per-box offsets are numpy's (the same IEEE operations
-    as one box at a time); ``math.hypot`` of the nearest few gives the result to the bit, whatever numpy's hypot
-    rounds differently."""
+    """Distance from a point to the nearest box or wall. ``math.hypot`` of the nearest few boxes (by the compiled
+    offsets) gives the result to the bit, whatever the compiled hypot rounds differently."""
     walls = world.size / 2 - max(abs(x), abs(y))
     centres, halves = world.box_extents
     if not len(centres):
         return walls
-    dx = np.maximum(np.abs(x - centres[:, 0]) - halves[:, 0], 0.0)
-    dy = np.maximum(np.abs(y - centres[:, 1]) - halves[:, 1], 0.0)
-    approx = np.hypot(dx, dy)
-    nearest = np.flatnonzero(approx <= approx.min() * (1 + 1e-9))
-    return min(walls, min(math.hypot(dx[k], dy[k]) for k in nearest))
+    dx, dy = _nearest_offsets(x, y, centres, halves)
+    return min(walls, min(map(math.hypot, dx, dy)))
+
+
+@njit("UniTuple(f8[::1], 2)(f8, f8, f8[:, ::1], f8[:, ::1])", cache=True)
+def _nearest_offsets(x, y, centres, halves):
+    """The offsets (dx, dy) from the point to the boxes whose distance is within a relative 1e-9 of the least."""
+    n = centres.shape[0]
+    dx, dy, approx = np.empty(n), np.empty(n), np.empty(n)
+    least = math.inf
+    for k in range(n):
+        dx[k] = max(abs(x - centres[k, 0]) - halves[k, 0], 0.0)
+        dy[k] = max(abs(y - centres[k, 1]) - halves[k, 1], 0.0)
+        approx[k] = math.hypot(dx[k], dy[k])
+        least = min(least, approx[k])
+    near = approx <= least * (1 + 1e-9)
+    return dx[near], dy[near]
 
 
 @dataclass(frozen=True)
@@ -338,20 +349,35 @@ class KinematicBody:
         self.bearings = 2 * np.pi * np.arange(robot.ir_count) / robot.ir_count
         self.sensor_radius = np.asarray(robot.sensor_radius or (robot.radius,) * robot.ir_count, float)
         self.velocity = (0.0, 0.0)  # odometry of the last tick's motion
+        self._rays = self._ranges = self._gap = None  # (pose, ...) of the last pose sensed, or checked
 
     def centre(self, x: float, y: float, heading: float) -> tuple[float, float]:
         offset = self.robot.centre_offset
         return x + offset * math.cos(heading), y + offset * math.sin(heading)
 
     def rays(self) -> tuple[np.ndarray, np.ndarray]:
-        """Each IR sensor's position and unit direction in the world, (n, 2) each."""
-        cx, cy = self.centre(self.x, self.y, self.heading)
-        directions = np.column_stack([np.cos(self.heading + self.bearings), np.sin(self.heading + self.bearings)])
-        return np.array([cx, cy]) + self.sensor_radius[:, None] * directions, directions
+        """Each IR sensor's position and unit direction in the world, (n, 2) each (kept for the pose)."""
+        pose = (self.x, self.y, self.heading)
+        if self._rays is None or self._rays[0] != pose:
+            angles = self.heading + self.bearings
+            directions = np.empty((len(angles), 2))
+            np.cos(angles, out=directions[:, 0])
+            np.sin(angles, out=directions[:, 1])
+            origins = self.sensor_radius[:, None] * directions
+            origins += self.centre(*pose)
+            self._rays = pose, origins, directions
+        return self._rays[1].copy(), self._rays[2].copy()
 
     def ranges(self, world: NavWorld, rays: tuple[np.ndarray, np.ndarray] | None = None) -> np.ndarray:
-        """Ideal readings along ``rays`` (default: this pose's, ``rays()``)."""
-        return ray_ranges(world, *(rays or self.rays()), self.robot.ir_range)
+        """Ideal readings along ``rays`` (default: this pose's, ``rays()``, kept for the pose: a robot standing
+        still reads the same)."""
+        if rays is not None:
+            return ray_ranges(world, *rays, self.robot.ir_range)
+        pose = (self.x, self.y, self.heading)
+        if self._ranges is None or self._ranges[0] is not world or self._ranges[1] != pose:
+            self.rays()
+            self._ranges = world, pose, ray_ranges(world, *self._rays[1:], self.robot.ir_range)
+        return self._ranges[2].copy()
 
     def motion(self, command, speed_scale: float = 1.0) -> tuple[float, float, float, tuple[float, float]]:
         """Where this tick's command would take the robot, and the odometry it would read."""
@@ -372,8 +398,12 @@ class KinematicBody:
         return nx, ny, nheading, (v, turn_rate)
 
     def gap(self, world: NavWorld, x: float, y: float, heading: float) -> float:
-        """Clearance between the enclosing circle at that pose and the nearest box or wall."""
-        return clearance(world, *self.centre(x, y, heading)) - self.robot.radius
+        """Clearance between the enclosing circle at that pose and the nearest box or wall (the last pose's kept:
+        a robot standing still asks again)."""
+        pose = (x, y, heading)
+        if self._gap is None or self._gap[0] is not world or self._gap[1] != pose:
+            self._gap = world, pose, clearance(world, *self.centre(x, y, heading)) - self.robot.radius
+        return self._gap[2]
 
     def move(self, x: float, y: float, heading: float, velocity: tuple[float, float]) -> float:
         """Take the pose; the distance moved."""
