@@ -127,11 +127,42 @@ def modified_target_heading(points: np.ndarray, target: float, robot_radius: flo
 
     Directions scoring within ``params.tie_tolerance`` of the best count as ties, broken towards ``previous``
     (the last theta_tmod, in the current robot frame): an obstacle dead ahead scores both ways round it almost
-    equally, and re-deciding every cycle would swing the robot between them."""
+    equally, and re-deciding every cycle would swing the robot between them. Compiled as one call: the same
+    arithmetic as ``obstacle_distances``, ``smooth`` and ``direction_objective`` composed (tested to the bit)."""
     directions, cos, sin = _candidates(params.directions)
-    distances = _distances_along(points, cos, sin, robot_radius, params.max_distance)
-    scores = direction_objective(directions, target, smooth(distances, params.smoothing), params)
-    if previous is None:
-        return float(directions[np.argmax(scores)])
-    ties = np.flatnonzero(scores >= scores.max() - params.tie_tolerance)
-    return float(directions[ties[np.argmin(np.abs(wrap(directions[ties] - previous)))]])
+    points = np.asarray(points, float).reshape(-1, 2)
+    return _heading(directions, cos, sin, np.ascontiguousarray(points[:, 0]), np.ascontiguousarray(points[:, 1]),
+                    robot_radius, params.max_distance, _kernel(params.smoothing), target, params.alpha1, params.beta,
+                    params.tie_tolerance, math.nan if previous is None else previous)
+
+
+@functools.lru_cache(maxsize=8)
+def _kernel(smoothing: tuple[float, ...]) -> np.ndarray:
+    return np.asarray(smoothing, float)
+
+
+@njit("f8(f8)", cache=True)
+def _wrap(angle):  # wrap() of one angle
+    return (angle + np.pi) % (2 * np.pi) - np.pi
+
+
+@njit("f8(f8[::1], f8[::1], f8[::1], f8[::1], f8[::1], f8, f8, f8[::1], f8, f8, f8, f8, f8)", cache=True)
+def _heading(directions, ux, uy, px, py, radius, max_distance, kernel, target, alpha1, beta,  # noqa: PLR0913
+             tie_tolerance, previous):
+    """``modified_target_heading``'s choice; ``previous`` NaN for none."""
+    smoothed = _smooth(_obstacle_distances(ux, uy, px, py, radius, radius ** 2, max_distance), kernel)
+    scores = np.empty(directions.shape[0])
+    for i in range(directions.shape[0]):  # (3.10), as direction_objective
+        goal_directedness = 1.0 - abs(_wrap(directions[i] - target)) / np.pi
+        scores[i] = alpha1 * goal_directedness + beta * smoothed[i] / max_distance
+    best = np.argmax(scores)
+    if previous != previous:
+        return directions[best]
+    floor = scores[best] - tie_tolerance
+    chosen, nearest = -1, math.inf
+    for i in range(directions.shape[0]):  # ties broken towards the previous choice, the first of equals
+        if scores[i] >= floor:
+            off = abs(_wrap(directions[i] - previous))
+            if off < nearest:
+                chosen, nearest = i, off
+    return directions[chosen]

@@ -91,12 +91,15 @@ def test_near_ties_keep_the_previous_side():
     assert modified_target_heading(np.zeros((0, 2)), 0.0, 0.35, previous=1.0) == 0.0
 
 
-def test_cached_candidates_give_the_heading_of_freshly_computed_ones():
+def test_the_compiled_choice_is_the_equations_composed_to_the_bit():
     rng = np.random.default_rng(5)
-    for _ in range(300):
-        params = DirectionSensorParams(directions=int(rng.choice([8, 41, 72])))
+    for _ in range(600):
+        count = int(rng.choice([8, 41, 72]))
+        params = DirectionSensorParams(directions=count, alpha1=rng.uniform(0.1, 1.0), beta=rng.uniform(0.1, 2.0),
+                                       tie_tolerance=float(rng.choice([0.02, 0.5])))
         points = rng.uniform(-2.0, 2.0, (int(rng.integers(0, 40)), 2))
-        target, previous = rng.uniform(-math.pi, math.pi), rng.choice([None, rng.uniform(-math.pi, math.pi)])
+        halfway = math.pi * (2 * int(rng.integers(count)) + 1) / count  # equally far from two directions
+        target, previous = rng.uniform(-math.pi, math.pi), rng.choice([None, rng.uniform(-math.pi, math.pi), halfway])
         directions = candidate_directions(params.directions)
         distances = obstacle_distances(points, directions, 0.35, params.max_distance)
         scores = direction_objective(directions, target, smooth(distances, params.smoothing), params)
