@@ -450,11 +450,8 @@ class DynamicWindow:
             v_max, v_min = v_glmax, -lim.v_max
         v_window = self.linear_window(state.v, v_min, v_max)
         w_lo, w_hi, alpha_min = self.angular_window(state, v_window)
-        v_samples = _samples(*v_window, p.n_vd)
-        w_samples = _samples(w_lo, w_hi, p.n_wd)
-        v, omega = np.repeat(v_samples, w_samples.size), np.tile(w_samples, v_samples.size)  # every pair
-        v_brake, w_brake = self._braking_continuation(state, v_window, (w_lo, w_hi))
-        v, omega = np.concatenate((v, [v_brake])), np.concatenate((omega, [w_brake]))
+        v, omega = _pairs(_samples(*v_window, p.n_vd), _samples(w_lo, w_hi, p.n_wd),
+                          self._braking_continuation(state, v_window, (w_lo, w_hi)))
 
         # Safety margin (3.26)-(3.27): no candidate may move the centre towards an obstacle inside it.
         margin = p.sm_min + p.k_sm * abs(state.v)
@@ -601,15 +598,27 @@ def _columns(points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 
 def _samples(lo: float, hi: float, count: int) -> np.ndarray:
-    """``count`` evenly spaced values over [lo, hi], plus 0 when it lies inside."""
+    """``count`` evenly spaced values over [lo, hi], plus 0 when it lies inside (in order)."""
     if hi > lo and count > 1:  # np.linspace's arithmetic, without its generality's cost
         values = np.arange(count, dtype=float) * ((hi - lo) / (count - 1)) + lo
         values[-1] = hi
     else:
         values = np.array([lo])
     if lo < 0.0 < hi:
-        values = np.unique(np.append(values, 0.0))
+        at = int(np.searchsorted(values, 0.0))
+        if at == values.size or values[at] != 0.0:
+            values = np.concatenate((values[:at], [0.0], values[at:]))
     return values
+
+
+def _pairs(v_samples: np.ndarray, w_samples: np.ndarray, last: tuple[float, float]) -> tuple[np.ndarray, ...]:
+    """Every (v, omega) of the samples, v-major, then the pair ``last``."""
+    n = v_samples.size * w_samples.size
+    v, omega = np.empty(n + 1), np.empty(n + 1)
+    v[:n].reshape(v_samples.size, w_samples.size)[:] = v_samples[:, None]
+    omega[:n].reshape(v_samples.size, w_samples.size)[:] = w_samples
+    v[n], omega[n] = last
+    return v, omega
 
 
 # ====================================================================== controllers

@@ -16,6 +16,7 @@ from dataclasses import dataclass, field
 from typing import Callable
 
 import numpy as np
+from numba import njit
 
 from teamsim.config import ConfigError
 from teamsim.controllers.base import Observation
@@ -156,14 +157,19 @@ class KinematicTeam:
         self.events.append({"t": round(self.time, 6), "event": "fault", **fault.describe()})
 
 
+@njit("f8[::1](f8[:, ::1], f8[:, ::1], f8[:, ::1], f8[::1], f8)", cache=True)
 def circle_ranges(origins: np.ndarray, directions: np.ndarray, centres: np.ndarray, radii: np.ndarray,
                   max_range: float) -> np.ndarray:
     """Distance along each ray (origin (n, 2), unit direction (n, 2)) to the nearest circle it enters ahead,
     ``inf`` where none lies within ``max_range``; a ray starting inside a circle does not see it."""
-    offset = centres[None, :, :] - origins[:, None, :]  # (rays, circles, 2)
-    along = np.einsum("rcd,rd->rc", offset, directions)
-    miss = np.einsum("rcd,rcd->rc", offset, offset) - along ** 2  # squared distance of the centre off the ray
-    depth = radii[None, :] ** 2 - miss
-    entry = along - np.sqrt(np.maximum(depth, 0.0))
-    seen = (depth >= 0) & (entry > 0) & (entry <= max_range)
-    return np.where(seen, entry, np.inf).min(axis=1)
+    out = np.full(origins.shape[0], np.inf)
+    for r in range(origins.shape[0]):
+        for c in range(centres.shape[0]):
+            ox, oy = centres[c, 0] - origins[r, 0], centres[c, 1] - origins[r, 1]
+            along = ox * directions[r, 0] + oy * directions[r, 1]
+            miss = (ox * ox + oy * oy) - along * along  # squared distance of the centre off the ray
+            depth = radii[c] * radii[c] - miss
+            entry = along - math.sqrt(max(depth, 0.0))
+            if depth >= 0 and 0 < entry <= max_range:
+                out[r] = min(out[r], entry)
+    return out

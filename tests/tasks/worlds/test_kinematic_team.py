@@ -1,10 +1,12 @@
-"""The kinematic team's shortcuts read exactly what the plain computation reads: a box's clearance from numpy's
-offsets and the nearest boxes' ``math.hypot``, and IR ranges that skip robots beyond every ray's reach."""
+"""The kinematic team's shortcuts read exactly what the plain computation reads: a box's clearance from the compiled
+offsets and the nearest boxes' ``math.hypot``, and IR ranges that skip robots beyond every ray's reach; the
+robots' circles by hand."""
 from __future__ import annotations
 
 import math
 
 import numpy as np
+import pytest
 
 from teamsim.models.robot import DriveLimits
 from teamsim.tasks.worlds.exploration import ExploreWorldParams, explore_world
@@ -42,3 +44,14 @@ def test_ranges_skipping_robots_out_of_reach_are_the_ranges_over_every_robot():
         every = circle_ranges(origins, directions, np.array([b.centre(b.x, b.y, b.heading) for b in others.values()]),
                               np.full(len(others), robot.radius), robot.ir_range)
         assert np.array_equal(team._ranges("me", me), np.minimum(me.ranges(WORLD), every))
+
+
+def test_circle_ranges_by_hand():
+    origins = np.array([[0.0, 0.0], [0.0, 0.0], [2.0, 0.1], [0.0, 0.4]])
+    directions = np.array([[1.0, 0.0], [-1.0, 0.0], [1.0, 0.0], [1.0, 0.0]])
+    centres, radii = np.array([[2.0, 0.0], [6.0, 0.0]]), np.array([0.5, 0.5])
+    ranges = circle_ranges(origins, directions, centres, radii, 1.5)
+    # ahead at 1.5 m; behind: none; starting inside the first circle and the second beyond reach: none;
+    # off the axis by 0.4: enters at 2 - sqrt(0.25 - 0.16) = 1.7 m, beyond the 1.5 m reach
+    assert ranges.tolist() == [1.5, math.inf, math.inf, math.inf]
+    assert circle_ranges(origins[3:], directions[3:], centres, radii, 2.0)[0] == pytest.approx(1.7)
