@@ -7,6 +7,7 @@
 - :func:`best_primary`: the choice by a primary objective ((3.35) FRC, (3.38) ODW and ODWDS, (3.39) RFRC),
   measuring DC_cd and ST_v only for the candidates that could still win (docs/decisions.md, "The primary
   objective without measuring every candidate");
+- :func:`reading_points`: an IR reading's obstacle points in the robot frame;
 - :func:`thin_to_robot_frame`: the obstacle memory, one point per 2 cm square, in the robot frame.
 - :func:`path_blocked`: HRDU's re-planning trigger, an impassable cell near the path ahead.
 
@@ -200,6 +201,23 @@ def best_primary(v, omega, base, admissible, dc_scale, all_x, all_y, radius, mar
         if best < 0 or score > best_score or (score == best_score and k < best):
             best, best_score = k, score
     return best, best_score
+
+
+@njit("f8[:, ::1](f8[::1], f8[::1], f8[::1], f8)", cache=True)
+def reading_points(ranges, bearings, sensor_radius, offset):
+    """The point each finite range reading marks, (m, 2) relative to the pose's reference point in the robot
+    frame: ``offset`` ahead of it is the centre, the sensor ``sensor_radius`` (one for all, or one per sensor) from
+    the centre along its bearing."""
+    if sensor_radius.shape[0] not in (1, ranges.shape[0]):
+        raise ValueError("one sensor radius, or one per reading")
+    out = np.empty((ranges.shape[0], 2))
+    m = 0
+    for i in range(ranges.shape[0]):
+        if np.isfinite(ranges[i]):
+            reach = sensor_radius[i if sensor_radius.shape[0] > 1 else 0] + ranges[i]
+            out[m, 0], out[m, 1] = offset + reach * math.cos(bearings[i]), reach * math.sin(bearings[i])
+            m += 1
+    return out[:m].copy()
 
 
 @njit("f8[:, ::1](f8[:, ::1], f8, f8, f8, f8, f8, f8)", cache=True)

@@ -811,12 +811,8 @@ class DynamicWindowController:
     def _seen(self, obs: Observation, contact: np.ndarray) -> np.ndarray:
         """This reading's obstacle points, and any stall ``contact``, relative to the pose's reference point in
         the robot frame."""
-        ranges = np.asarray(obs.ir_range, float)
-        bearings = np.asarray(obs.ir_bearings, float)
-        seen = np.isfinite(ranges)
-        reach = np.broadcast_to(self.sensor_radius, ranges.shape)[seen] + ranges[seen]
-        body = np.empty((len(reach), 2))
-        body[:, 0], body[:, 1] = self.offset + reach * np.cos(bearings[seen]), reach * np.sin(bearings[seen])
+        body = kernels.reading_points(_floats(obs.ir_range), _floats(obs.ir_bearings),
+                                      _floats(self.sensor_radius.reshape(-1)), self.offset)
         return np.concatenate([body, contact]) if len(contact) else body
 
     def _remember(self, time: float, body: np.ndarray) -> np.ndarray:

@@ -174,3 +174,16 @@ def test_path_blocked_matches_the_numpy_form():
         assert kernels.path_blocked(probabilities, ahead, *origin, resolution, reach, threshold) == expected
         blocked += expected
     assert 300 < blocked < 2700  # both answers are tested
+
+
+def test_reading_points_by_hand():
+    ranges = np.array([1.0, np.inf, 0.5, 0.25])
+    bearings = np.array([0.0, math.pi / 2, math.pi / 2, math.pi])
+    # sensors 0.3 m from a centre 0.1 m ahead of the reference point; the unseen reading marks nothing
+    points = kernels.reading_points(ranges, bearings, np.array([0.3]), 0.1)
+    np.testing.assert_allclose(points, [[1.4, 0.0], [0.1, 0.8], [-0.45, 0.0]], atol=1e-12)
+    # one radius per sensor
+    per_sensor = kernels.reading_points(ranges, bearings, np.array([0.3, 0.3, 0.5, 0.3]), 0.0)
+    np.testing.assert_allclose(per_sensor, [[1.3, 0.0], [0.0, 1.0], [-0.55, 0.0]], atol=1e-12)
+    with pytest.raises(ValueError):
+        kernels.reading_points(ranges, bearings, np.array([0.3, 0.3]), 0.0)
