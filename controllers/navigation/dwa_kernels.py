@@ -7,6 +7,8 @@
 - :func:`best_primary`: the choice by a primary objective ((3.35) FRC, (3.38) ODW and ODWDS, (3.39) RFRC),
   measuring DC_cd and ST_v only for the candidates that could still win (docs/decisions.md, "The primary
   objective without measuring every candidate");
+- :func:`sector_nearest` and :func:`primary_terms`: a decision's nearest obstacles ahead and behind, and its
+  candidates' heading and speed terms;
 - :func:`reading_points`: an IR reading's obstacle points in the robot frame;
 - :func:`thin_to_robot_frame`: the obstacle memory, one point per 2 cm square, in the robot frame.
 - :func:`path_blocked`: HRDU's re-planning trigger, an impassable cell near the path ahead.
@@ -201,6 +203,35 @@ def best_primary(v, omega, base, admissible, dc_scale, all_x, all_y, radius, mar
         if best < 0 or score > best_score or (score == best_score and k < best):
             best, best_score = k, score
     return best, best_score
+
+
+@njit("UniTuple(f8, 3)(f8[::1], f8[::1], f8, f8, f8)", cache=True)
+def sector_nearest(distance, bearing, front_half_angle, rear_from, immediate_rear_from):
+    """The nearest ``distance`` of the points whose |bearing| is at most ``front_half_angle`` ((3.15)-(3.16)), at
+    least ``rear_from`` ((3.19)-(3.20)) and at least ``immediate_rear_from`` ((3.21)-(3.22)); inf where none."""
+    front = rear = immediate_rear = math.inf
+    for j in range(distance.shape[0]):
+        if bearing[j] <= front_half_angle:
+            front = min(front, distance[j])
+        if bearing[j] >= rear_from:
+            rear = min(rear, distance[j])
+        if bearing[j] >= immediate_rear_from:
+            immediate_rear = min(immediate_rear, distance[j])
+    return front, rear, immediate_rear
+
+
+@njit("UniTuple(f8[::1], 2)(f8[::1], f8[::1], f8, f8, f8, f8, f8, f8)", cache=True)
+def primary_terms(v, omega, heading, dt, angular_accel_max, v_max, alpha2, gamma):  # noqa: PLR0913
+    """Each candidate's heading term (the heading it will have turned by once a turn at omega is stopped at the
+    drive's angular limit, against ``heading``) and its primary base alpha_2 heading + gamma |v| / v_max."""
+    heading_term, base = np.empty(v.shape[0]), np.empty(v.shape[0])
+    for k in range(v.shape[0]):
+        turned = omega[k] * dt + omega[k] * abs(omega[k]) / (2 * angular_accel_max)
+        off = (heading - turned + np.pi) % (2 * np.pi) - np.pi
+        heading_term[k] = 1.0 - abs(off) / np.pi
+        speed_term = abs(v[k]) / v_max if v_max > 0 else 0.0
+        base[k] = alpha2 * heading_term[k] + gamma * speed_term
+    return heading_term, base
 
 
 @njit("f8[:, ::1](f8[::1], f8[::1], f8[::1], f8)", cache=True)

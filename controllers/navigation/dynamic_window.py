@@ -434,13 +434,10 @@ class DynamicWindow:
         points = np.asarray(points, float).reshape(-1, 2)
         distance = np.hypot(points[:, 0], points[:, 1])
         bearing = np.abs(np.arctan2(points[:, 1], points[:, 0]))
-
-        def nearest(mask):
-            return float(distance[mask].min()) if mask.any() else math.inf
-
-        d_obfr = nearest(bearing <= p.front_half_angle)  # (3.15)-(3.16)
-        d_obrr = nearest(bearing >= math.pi - p.rear_half_angle)  # (3.19)-(3.20)
-        d_obirr = nearest(bearing >= math.pi - p.immediate_rear_half_angle)  # (3.21)-(3.22)
+        # d_obfr (3.15)-(3.16), d_obrr (3.19)-(3.20), d_obirr (3.21)-(3.22)
+        d_obfr, d_obrr, d_obirr = kernels.sector_nearest(distance, bearing, p.front_half_angle,
+                                                         math.pi - p.rear_half_angle,
+                                                         math.pi - p.immediate_rear_half_angle)
 
         v_glmax = min(self.goal_speed_limit(d_tgt), v_cap)
         if self.method.modified:
@@ -460,11 +457,8 @@ class DynamicWindow:
 
         curvature_ok, steers_to_close = self._curvature_checks(state, v, omega, points, distance)
         admissible = safe & curvature_ok
-        # The heading turned by the time a turn at omega_cd has been stopped at the drive's angular limit.
-        turned = omega * self.dt + omega * np.abs(omega) / (2 * lim.angular_accel_max)
-        heading_term = 1.0 - np.abs(wrap(heading - turned)) / np.pi
-        speed_term = np.abs(v) / v_max if v_max > 0 else np.zeros_like(v)
-        base = p.alpha2 * heading_term + p.gamma * speed_term
+        heading_term, base = kernels.primary_terms(v, omega, heading, self.dt, lim.angular_accel_max, v_max, p.alpha2,
+                                                   p.gamma)
         best, score = self.best_primary(v, omega, base, admissible, steers_to_close, points, margin, alpha_min)
         if best >= 0:  # (3.35), (3.38), (3.39)
             return Decision(float(v[best]), float(omega[best]), "primary", score, v_min)

@@ -187,3 +187,21 @@ def test_reading_points_by_hand():
     np.testing.assert_allclose(per_sensor, [[1.3, 0.0], [0.0, 1.0], [-0.55, 0.0]], atol=1e-12)
     with pytest.raises(ValueError):
         kernels.reading_points(ranges, bearings, np.array([0.3, 0.3]), 0.0)
+
+
+def test_sector_nearest_by_hand():
+    distance = np.array([2.0, 1.0, 3.0, 0.5])
+    bearing = np.array([0.1, 0.5, 3.0, 2.0])  # |bearing|: ahead, ahead-left, behind, beside
+    assert kernels.sector_nearest(distance, bearing, 0.6, 2.5, 3.1) == (1.0, 3.0, math.inf)
+    assert kernels.sector_nearest(distance[:0], bearing[:0], 0.6, 2.5, 3.1) == (math.inf,) * 3
+
+
+def test_primary_terms_by_hand():
+    v, omega = np.array([0.25, 0.5]), np.array([0.0, 0.2])
+    heading_term, base = kernels.primary_terms(v, omega, 0.5, 0.1, 0.15, 0.5, 2.0, 0.2)
+    turned = 0.2 * 0.1 + 0.2 * 0.2 / (2 * 0.15)  # turned by the time the turn is stopped
+    np.testing.assert_allclose(heading_term, [1 - 0.5 / math.pi, 1 - (0.5 - turned) / math.pi], rtol=1e-14)
+    np.testing.assert_allclose(base, 2.0 * heading_term + 0.2 * np.array([0.5, 1.0]), rtol=1e-14)
+    # a heading behind wraps: 3 rad off to the left minus a turn of -0.5 is 3.5, i.e. 2 pi - 3.5 to the right
+    assert kernels.primary_terms(np.array([0.0]), np.array([-0.5]), 3.0, 1.0, 1e9, 0.5, 1.0, 0.0)[0][0] == \
+        pytest.approx(1 - (2 * math.pi - 3.5) / math.pi)
