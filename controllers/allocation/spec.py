@@ -192,7 +192,7 @@ def load_tasks(path: Path | str | None = None) -> list[TaskSpec]:
         for task in raw:
             if task.role == "worker" and task.quantity[2] == 0:  # maximum defaults to the largest initial (§5.4)
                 task = replace(task, quantity=(task.quantity[0], task.quantity[1], largest))
-            for other in task.concurrent:
+            for other in sorted(task.concurrent):  # the same error in every process
                 _choice(other, f"tasks.{task.id}.concurrent", [i for i in ids if i != task.id], "task")
             tasks.append(task)
     except ConfigError as exc:

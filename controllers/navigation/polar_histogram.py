@@ -47,6 +47,8 @@ class DirectionSensorParams:
 
 def wrap(angle):
     """Angles in [-pi, pi)."""
+    if isinstance(angle, float):  # one angle: the same arithmetic without numpy's overhead
+        return (angle + math.pi) % (2 * math.pi) - math.pi
     return (np.asarray(angle, float) + np.pi) % (2 * np.pi) - np.pi
 
 

@@ -109,3 +109,10 @@ def test_the_compiled_choice_is_the_equations_composed_to_the_bit():
             ties = np.flatnonzero(scores >= scores.max() - params.tie_tolerance)
             expected = directions[ties[np.argmin(np.abs(wrap(directions[ties] - previous)))]]
         assert modified_target_heading(points, target, 0.35, params, previous) == expected
+
+
+def test_wrap_of_one_angle_is_the_array_form_to_the_bit():
+    angles = np.concatenate([np.random.default_rng(2).uniform(-20, 20, 2000),
+                             [math.pi, -math.pi, 3 * math.pi, 0.0, -0.0, 2 * math.pi, 1e-300]])
+    one_by_one = np.array([wrap(float(a)) for a in angles])
+    assert np.array_equal(one_by_one, wrap(angles)) and np.array_equal(np.signbit(one_by_one), np.signbit(wrap(angles)))
