@@ -25,6 +25,8 @@ import math
 import numpy as np
 from numba import njit
 
+from teamsim.controllers.navigation.polar_histogram import wrap_one
+
 STILL = 1e-9  # |v| or |omega| at or below this is zero
 BAND_SLACK = 1e-9  # relative: the squared pre-test against an arc's band never drops a point the exact test keeps
 
@@ -227,8 +229,7 @@ def primary_terms(v, omega, heading, dt, angular_accel_max, v_max, alpha2, gamma
     heading_term, base = np.empty(v.shape[0]), np.empty(v.shape[0])
     for k in range(v.shape[0]):
         turned = omega[k] * dt + omega[k] * abs(omega[k]) / (2 * angular_accel_max)
-        off = (heading - turned + np.pi) % (2 * np.pi) - np.pi
-        heading_term[k] = 1.0 - abs(off) / np.pi
+        heading_term[k] = 1.0 - abs(wrap_one(heading - turned)) / np.pi
         speed_term = abs(v[k]) / v_max if v_max > 0 else 0.0
         base[k] = alpha2 * heading_term[k] + gamma * speed_term
     return heading_term, base

@@ -144,7 +144,8 @@ def _kernel(smoothing: tuple[float, ...]) -> np.ndarray:
 
 
 @njit("f8(f8)", cache=True)
-def _wrap(angle):  # wrap() of one angle
+def wrap_one(angle):
+    """``wrap`` of one angle, compiled."""
     return (angle + np.pi) % (2 * np.pi) - np.pi
 
 
@@ -155,7 +156,7 @@ def _heading(directions, ux, uy, px, py, radius, max_distance, kernel, target, a
     smoothed = _smooth(_obstacle_distances(ux, uy, px, py, radius, radius ** 2, max_distance), kernel)
     scores = np.empty(directions.shape[0])
     for i in range(directions.shape[0]):  # (3.10), as direction_objective
-        goal_directedness = 1.0 - abs(_wrap(directions[i] - target)) / np.pi
+        goal_directedness = 1.0 - abs(wrap_one(directions[i] - target)) / np.pi
         scores[i] = alpha1 * goal_directedness + beta * smoothed[i] / max_distance
     best = np.argmax(scores)
     if previous != previous:
@@ -164,7 +165,7 @@ def _heading(directions, ux, uy, px, py, radius, max_distance, kernel, target, a
     chosen, nearest = -1, math.inf
     for i in range(directions.shape[0]):  # ties broken towards the previous choice, the first of equals
         if scores[i] >= floor:
-            off = abs(_wrap(directions[i] - previous))
+            off = abs(wrap_one(directions[i] - previous))
             if off < nearest:
                 chosen, nearest = i, off
     return directions[chosen]

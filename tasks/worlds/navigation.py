@@ -356,7 +356,12 @@ class KinematicBody:
         return x + offset * math.cos(heading), y + offset * math.sin(heading)
 
     def rays(self) -> tuple[np.ndarray, np.ndarray]:
-        """Each IR sensor's position and unit direction in the world, (n, 2) each (kept for the pose)."""
+        """Each IR sensor's position and unit direction in the world, (n, 2) each."""
+        origins, directions = self._pose_rays()
+        return origins.copy(), directions.copy()
+
+    def _pose_rays(self) -> tuple[np.ndarray, np.ndarray]:
+        """``rays()`` as kept for the current pose (not to be changed)."""
         pose = (self.x, self.y, self.heading)
         if self._rays is None or self._rays[0] != pose:
             angles = self.heading + self.bearings
@@ -366,7 +371,7 @@ class KinematicBody:
             origins = self.sensor_radius[:, None] * directions
             origins += self.centre(*pose)
             self._rays = pose, origins, directions
-        return self._rays[1].copy(), self._rays[2].copy()
+        return self._rays[1], self._rays[2]
 
     def ranges(self, world: NavWorld, rays: tuple[np.ndarray, np.ndarray] | None = None) -> np.ndarray:
         """Ideal readings along ``rays`` (default: this pose's, ``rays()``, kept for the pose: a robot standing
@@ -375,8 +380,7 @@ class KinematicBody:
             return ray_ranges(world, *rays, self.robot.ir_range)
         pose = (self.x, self.y, self.heading)
         if self._ranges is None or self._ranges[0] is not world or self._ranges[1] != pose:
-            self.rays()
-            self._ranges = world, pose, ray_ranges(world, *self._rays[1:], self.robot.ir_range)
+            self._ranges = world, pose, ray_ranges(world, *self._pose_rays(), self.robot.ir_range)
         return self._ranges[2].copy()
 
     def motion(self, command, speed_scale: float = 1.0) -> tuple[float, float, float, tuple[float, float]]:
