@@ -19,8 +19,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from teamsim.controllers.exploration.assignment import (ExplorerState, Proposal, candidate_environments,
-                                                        mutual_exclusion, propose)
+from teamsim.controllers.exploration.assignment import (AVAILABLE, ExplorerState, Proposal,
+                                                        candidate_environments, mutual_exclusion, propose)
 from teamsim.controllers.exploration.job_queue import ect_acceptable, estimated_completion_time
 from teamsim.controllers.exploration.territory import SMALL_MESSAGE, Territory
 from teamsim.controllers.navigation.two_tier_astar import TwoTierParams, two_tier_astar
@@ -121,7 +121,8 @@ class Planner:
         if candidates:
             proposal = propose(explorer, job["others"], self.territory.centres, self.territory.neighbour_lists,
                                candidates, status, job_id=job["job_id"])
-        if proposal is None or not self._ect_acceptable(job, proposal, len(candidates)):
+        available = sum(state in AVAILABLE for state in status)  # the team's, not this explorer's candidates
+        if proposal is None or not self._ect_acceptable(job, proposal, available):
             self.send("no-environment", {"job_id": job["job_id"], "explorer": explorer.name}, to=self.manager)
             return
         self.heard = [p for p in self.heard if p.environment != proposal.environment or p.job_id != job["job_id"]]
@@ -129,7 +130,10 @@ class Planner:
         self.negotiation = _Negotiation(job, proposal, now + self.params.negotiation, excluded)
 
     def _ect_acceptable(self, job: dict, proposal: Proposal, available: int) -> bool:
-        """§6.4.3: only when fewer environments remain than explorers; the manager's figures come with the job."""
+        """§6.4.3: only when fewer environments remain than explorers; the manager's figures come with the job.
+        ``available`` counts every available environment, as the manager's purge does, not only this explorer's
+        candidates: a tracked explorer offered the one boggy environment left was otherwise refused, and retired,
+        while dry ones remained (docs/decisions.md, "ECT when environments run short")."""
         figures = job["ect"]
         if available >= len(figures):
             return True

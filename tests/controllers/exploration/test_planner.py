@@ -122,3 +122,31 @@ def test_when_environments_run_short_a_slow_explorer_s_ect_is_not_acceptable():
         planner.step(0.0)
         kinds = [p.kind for p in planner.outbox]
         assert kinds == (["no-environment"] if refused else ["propose"])
+
+
+def test_a_tracked_explorer_gets_the_last_boggy_environment_while_dry_ones_remain():
+    """Three explorers; two UE environments are left, one boggy: Fig 6.7 offers the tracked Robot4 only the boggy
+    one, and Robot4 is the slowest by ECT. Two environments for three explorers is "running short", so ECT ranks
+    Robot4 third of three: no environment. With a third (dry) environment open the environments do not run short
+    and Robot4 is given the boggy one, though it is its only candidate (counting its candidates retired it:
+    docs/decisions.md, "ECT when environments run short")."""
+    tracked = ExplorerState("Robot4", (-4.8, -4.8), 1.0, True, WEST)
+    others = [ExplorerState("Robot2", (4.8, -4.8), 1.0, False, EAST),
+              ExplorerState("Robot5", (4.8, 4.8), 1.0, False, None)]
+    figures = {"Robot4": {"time": 600.0, "unexplored_current": 0.0, "explored": 50.0, "rate": 1.0},
+               "Robot2": {"time": 600.0, "unexplored_current": 0.0, "explored": 400.0, "rate": 1.0},
+               "Robot5": {"time": 600.0, "unexplored_current": 0.0, "explored": 400.0, "rate": 1.0}}
+    for open_environments, expected in (((MIDDLE, NORTH_MIDDLE), "no-environment"),
+                                        ((MIDDLE, NORTH_MIDDLE, EAST), "propose")):
+        status = ["E"] * TERRITORY.environments
+        for environment in open_environments:
+            status[environment] = "UE"
+        job = assignment_job(1, tracked, others[0], status) | {
+            "others": others, "ect": figures, "unexplored": [1024.0] * len(status),
+            "boggy": [e == MIDDLE for e in range(len(status))]}
+        planner = Planner("Robot6", TERRITORY, manager="Robot3")
+        planner.receive("job", job, 100)
+        planner.step(0.0)
+        assert [p.kind for p in planner.outbox] == [expected]
+        if expected == "propose":
+            assert planner.outbox[0].payload["proposal"].environment == MIDDLE
