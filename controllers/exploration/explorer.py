@@ -5,7 +5,8 @@ cover it by the waypoints of (6.1)-(6.2), map it from its IR readings by (6.3)-(
   followed to the environment's centre; each coverage waypoint is reached along a plan of the explorer's own on
   its own map, which favours unexplored cells (3.5) and is re-made on poor progress (3.6). Persistent poor progress
   (no ``progress`` m closer in ``give_up`` s) marks a waypoint inaccessible; on the way to an environment it asks
-  for a new path, and the second time for a new environment.
+  for a new path, and the second time for a new environment; inside the environment, with its centre out of reach
+  or mapped occupied, coverage starts from where it is.
 - **Mapping**: every reading updates the explorer's own map and an outgoing map of the evidence gathered since the
   last update sent; every ``map_period`` s the outgoing local maps that changed go to the manager (8 KB each) and
   are reset to 0.5, so that the manager's (6.15) counts each reading once.
@@ -161,7 +162,7 @@ class Explorer:
             self.progress_mark = (obs.time, distance)
         stuck = obs.time - self.progress_mark[0] >= self.params.give_up
         if self.state == "travel":
-            if self._near(centre, goal) or command.behaviour == "arrived":
+            if self._near(centre, goal) or command.behaviour == "arrived" or self._centre_blocked(centre, stuck):
                 self._start_exploring(obs.time, centre)
             elif stuck:
                 self._travel_stuck(obs.time, centre)
@@ -173,6 +174,14 @@ class Explorer:
 
     def _near(self, centre, goal) -> bool:
         return math.dist(centre, goal) <= self.params.waypoint_reach
+
+    def _centre_blocked(self, centre, stuck: bool) -> bool:
+        """Inside its environment, with the centre mapped occupied (a box on it, or a robot standing at the base)
+        or out of reach (persistent poor progress): coverage starts from where it is, as it would at the centre.
+        Asking for another path or environment instead left such environments partly explored (docs/decisions.md,
+        "Exploration", travel)."""
+        inside = self.territory.environment_of(*centre) == self.assignment.environment
+        return inside and (stuck or self._occupied(self.nav.goal))
 
     def _occupied(self, point) -> bool:
         """The explorer's own map says the waypoint lies in an obstacle: it cannot be reached."""

@@ -156,3 +156,30 @@ def test_a_tracked_explorer_reports_a_bog_and_drives_on():
     v, omega, behaviour = robot.step(observe(t, (x, -4.8, 0.0), velocity=(0.01, 0.0), effort=0.6))
     assert robot.state == "travel" and behaviour == "explorer: travel E1" and v >= 0.0
     assert not sent(robot, "reset") and len(sent(robot, "request")) == 1
+
+
+def test_inside_its_environment_an_explorer_whose_centre_is_out_of_reach_starts_covering_from_where_it_is():
+    """The centre mapped occupied (a box on it, a robot standing there): coverage starts at once inside the
+    environment, not outside it. Stuck inside for ``give_up`` s (the centre cannot be reached): coverage starts
+    then, with no request; stuck outside, a new path is asked for (the first test)."""
+    for blocked in (True, False):
+        robot = explorer(bog_capable=False)
+        centre = robot.territory.centre(0)
+        if blocked:
+            row, col = robot.territory.cell_of(*centre)
+            robot.nav.grid.probabilities[row, col] = 0.95
+        outside = (centre[0] + 5.5, centre[1], math.pi)  # in environment 1, east of 0
+        t = assigned(robot, 0, start=outside)
+        robot.step(observe(t, outside))
+        assert robot.state == "travel"
+        inside = (centre[0] + 3.0, centre[1], math.pi)
+        t += TICK
+        while robot.state == "travel" and t < 2 * robot.params.give_up:
+            robot.step(observe(t, inside))
+            t += TICK
+        assert robot.state == "explore" and robot.waypoints is not None
+        assert len(sent(robot, "request")) == 1  # only the first, for an environment
+        if blocked:
+            assert t < 4 * TICK  # the first tick inside
+        else:
+            assert robot.params.give_up - TICK <= t <= robot.params.give_up + 1.0
