@@ -11,9 +11,10 @@ cover it by the waypoints of (6.1)-(6.2), map it from its IR readings by (6.3)-(
   last update sent; every ``map_period`` s the outgoing local maps that changed go to the manager (8 KB each) and
   are reset to 0.5, so that the manager's (6.15) counts each reading once.
 - **Bogs**: high drive effort while moving, for ``bog_time`` s. Every explorer reports the bog; one that cannot cross
-  bogs also reverses along its own trail to ``back_out_distance`` short of where the bog slowed it (the thesis:
-  to the first node of its current path, which may lie far back), sends the manager the cells it mapped from
-  inside the bog to be reset to unexplored (0.5), and asks for a non-boggy environment (§6.2.2).
+  bogs also reverses along its own trail to ``back_out_distance`` short of where the bog slowed it, and on until
+  the ground is firm (the thesis: to the first node of its current path, which may lie far back), sends the
+  manager the cells it mapped from inside the bog to be reset to unexplored (0.5), and asks for a non-boggy
+  environment (§6.2.2).
 - **Feedback** (§5.6.1, Table 5.30): it counts its achievements per T_m for the manager's monitor.
 Thresholds the thesis does not give are in ``ExplorerParams`` and docs/decisions.md ("Exploration").
 """
@@ -25,6 +26,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from teamsim.controllers.exploration.bogs import keep_out
 from teamsim.controllers.exploration.territory import SMALL_MESSAGE, Territory
 from teamsim.controllers.exploration.waypoints import WaypointParams, coverage_waypoints
 from teamsim.controllers.navigation.dynamic_window import HRDU
@@ -46,7 +48,10 @@ class ExplorerParams:
     bog_turn: float = 0.1  # ... and hardly turns (rad/s; a tracked robot's skid turn takes up to 0.8 effort) ...
     bog_time: float = 1.5  # ... for this long: a bog
     back_out_limit: float = 60.0  # s of reversing at most; it also stops when something behind stalls it
-    back_out_distance: float = 2.0  # m of its own trail to reverse beyond where the bog slowed it
+    back_out_distance: float = 2.0  # m of its own trail to reverse beyond where the bog slowed it, and on
+    # straight back, this far at a time, until the ground is firm: ...
+    firm_speed: float = 0.1  # ... moving at this share of v_max or more, with an effort under bog_effort per unit
+    # of that share (firm ground measured at most about 0.1 per unit cruising; bogs 0.3 (tracked) to 10 (diffdrive))
     waypoints: WaypointParams = WaypointParams()
 
 
@@ -108,6 +113,7 @@ class Explorer:
         self.outbox: list[Packet] = []
         self.environments_done: list[int] = []
         self.trail: deque = deque(maxlen=TRAIL_TICKS)  # (time, x, y), for backing out of a bog
+        self.bogs_met: list[tuple[float, float, float]] = []  # (x, y, heading) where a bog turned it back
 
     # -- messages -----------------------------------------------------------------------------------------------
     def send(self, kind: str, payload: dict, size: int = SMALL_MESSAGE, to: str | None = None) -> None:
@@ -183,6 +189,14 @@ class Explorer:
         inside = self.territory.environment_of(*centre) == self.assignment.environment
         return inside and (stuck or self._occupied(self.nav.goal))
 
+    def _avoid_bogs(self) -> None:
+        """Its own plans (HRDU's re-plans on its own map, which the planner's avoidance does not reach) keep out
+        of the bogs it met, from where it stands now (``bogs``)."""
+        if self.bogs_met and self.trail:
+            _, x, y = self.trail[-1]
+            grid = self.nav.grid
+            self.nav.keep_out = keep_out(self.bogs_met, (x, y), self.radius, grid.origin, grid.resolution, grid.shape)
+
     def _occupied(self, point) -> bool:
         """The explorer's own map says the waypoint lies in an obstacle: it cannot be reached."""
         grid = self.nav.grid
@@ -194,6 +208,7 @@ class Explorer:
             self.poor_paths = 0
         self.assignment = Assignment(environment, path)
         self.state = "travel"
+        self._avoid_bogs()
         self.nav.retarget(self.territory.centre(environment), path if len(path) > 1 else None)
         self.progress_mark = (-math.inf, math.inf)
 
@@ -219,6 +234,7 @@ class Explorer:
             self._finish_environment(now)
             return
         plans = self.nav.replans
+        self._avoid_bogs()
         self.nav.retarget(self.waypoints.pop(0))
         self.achievement.local_path_plans += 1 + self.nav.replans - plans
         self.progress_mark = (now, math.inf)
@@ -299,25 +315,26 @@ class Explorer:
 
     def _enter_bog(self, obs, pose) -> tuple[float, float, str]:
         environment = self.territory.environment_of(pose[0], pose[1])
-        self.send("bog", {"environment": environment, "position": (pose[0], pose[1])})
+        reversing = obs.velocity is not None and obs.velocity[0] < 0
+        met = (pose[0], pose[1], pose[2] + (math.pi if reversing else 0.0))  # the way it was going
+        self.send("bog", {"environment": environment, "position": met[:2], "heading": met[2]})
         self.bog = _Bog(self.slow_since, self._before_bog(self.slow_since, pose), [(pose[0], pose[1])])
         if self.bog_capable:
             return self._drive(obs, pose)
+        self.bogs_met.append(met)
         self.state = "back-out"
         self.back_out_since = obs.time
         self.stalled_since = None
         return self._back_out(obs, pose)
 
     def _before_bog(self, entered: float, pose) -> tuple[float, float]:
-        """Where to reverse to: the point of the robot's own trail ``back_out_distance`` short of where the bog
-        slowed it; straight back that far if the trail does not lead away (a robot that has stood still)."""
+        """Where to reverse to: the latest point of the robot's own trail ``back_out_distance`` away from where
+        the bog slowed it (as the crow flies: a trail that curved in leaves it nearer the bog than its length says);
+        straight back that far if the trail does not lead away (a robot that has stood still)."""
         trail = [(t, x, y) for t, x, y in self.trail if t <= entered] or list(self.trail)[:1]
-        _, x, y = trail[-1]
-        travelled = 0.0
-        for _, px, py in reversed(trail):
-            travelled += math.dist((x, y), (px, py))
-            x, y = px, py
-            if travelled >= self.params.back_out_distance:
+        _, *slowed = trail[-1]
+        for _, x, y in reversed(trail):
+            if math.dist((x, y), slowed) >= self.params.back_out_distance:
                 break
         if math.dist((x, y), pose[:2]) < self.params.back_out_distance / 2:
             x = pose[0] - self.params.back_out_distance * math.cos(pose[2])
@@ -325,19 +342,34 @@ class Explorer:
         return x, y
 
     def _back_out(self, obs, pose) -> tuple[float, float, str]:
-        """Reverse towards the point before the bog, steering the tail at it."""
+        """Reverse towards the point before the bog, steering the tail at it; reached on ground that is still
+        boggy (the robot had crept along inside the bog before the sign held), on straight back until it is firm.
+        Ends there, or stalled, or after ``back_out_limit`` s."""
         target = self.bog.first_node
         moving = obs.velocity is not None and abs(obs.velocity[0]) >= self.params.bog_speed
         self.stalled_since = None if moving else (self.stalled_since or obs.time)
         blocked = self.stalled_since is not None and obs.time - self.stalled_since >= self.params.bog_time
-        if math.dist(pose[:2], target) <= self.params.waypoint_reach or blocked or \
-                obs.time - self.back_out_since >= self.params.back_out_limit:
+        reached = math.dist(pose[:2], target) <= self.params.waypoint_reach
+        if reached and not self._firm(obs):  # its trail ran inside the bog: on, straight back
+            distance = self.params.back_out_distance
+            target = self.bog.first_node = (pose[0] - distance * math.cos(pose[2]),
+                                            pose[1] - distance * math.sin(pose[2]))
+            reached = False
+        if reached or blocked or obs.time - self.back_out_since >= self.params.back_out_limit:
             return self._left_bog(obs.time)
         behind = math.atan2(target[1] - pose[1], target[0] - pose[0]) - (pose[2] + math.pi)
         error = math.atan2(math.sin(behind), math.cos(behind))
         limits = self.nav.window.limits
         return -0.6 * limits.v_max, float(np.clip(1.5 * error, -limits.omega_max, limits.omega_max)), \
             "explorer: back out of bog"
+
+    def _firm(self, obs) -> bool:
+        """Firm ground under the moving robot: its drive effort per unit of speed (|v| / v_max) is under what a
+        bog takes. Without an effort reading, taken as firm."""
+        if obs.drive_effort is None or obs.velocity is None:
+            return True
+        share = abs(obs.velocity[0]) / self.nav.window.limits.v_max
+        return share >= self.params.firm_speed and obs.drive_effort < self.params.bog_effort * share
 
     def _left_bog(self, now: float) -> tuple[float, float, str]:
         """Out: what it mapped from inside the bog is reset to unexplored, here and at the manager (§6.2.2), and

@@ -54,7 +54,7 @@ class GlobalInfo:
         self.global_map = np.full((territory.cells, territory.cells), 0.5)
         self.status = ["UE"] * territory.environments
         self.boggy = [False] * territory.environments
-        self.bog_points: list[tuple[float, float]] = []  # where explorers reported bogs
+        self.bog_points: list[tuple[float, float, float]] = []  # where explorers met bogs, the way they went
         self.explored = np.zeros(territory.environments)  # EA (6.17) at the last integration
         self.explorers = list(explorers)
         self.planners = list(planners)
@@ -109,7 +109,7 @@ class GlobalInfo:
 
     def _on_bog(self, sender: str, payload: dict, now: float) -> None:
         environment = payload["environment"]
-        self.bog_points.append(tuple(payload["position"]))
+        self.bog_points.append((*payload["position"], payload["heading"]))
         if not self.boggy[environment]:
             self.boggy[environment] = True
             self.log.append({"t": now, "event": "bog", "robot": sender, "environment": environment})

@@ -2,7 +2,7 @@
 (6.6)-(6.10), settle it with the other planners by distributed mutual exclusion, check its ECT acceptability when
 environments run short (5.23, §6.4.3), and plan the explorer's path to the environment's centre with the
 two-tiered A* (ch.4), round the environments assigned to others and, for a wheeled explorer, the boggy ones and
-the spots where bogs were reported.
+the bogs met (``bogs``).
 
 Negotiation: a planner broadcasts its proposal to the other planners and waits ``negotiation`` s for theirs; of
 the proposals for one environment the minimum trade-off wins, then the lowest job ID (§6.3); a planner that loses
@@ -21,6 +21,7 @@ import numpy as np
 
 from teamsim.controllers.exploration.assignment import (AVAILABLE, ExplorerState, Proposal,
                                                         candidate_environments, mutual_exclusion, propose)
+from teamsim.controllers.exploration.bogs import keep_out
 from teamsim.controllers.exploration.job_queue import ect_acceptable, estimated_completion_time
 from teamsim.controllers.exploration.territory import SMALL_MESSAGE, Territory
 from teamsim.controllers.navigation.two_tier_astar import TwoTierParams, two_tier_astar
@@ -34,8 +35,6 @@ class PlannerParams:
     negotiation: float = 0.5  # s to wait for the other planners' proposals (not given; a few radio round trips)
     memories: int = 2  # Q, local-map memories of the two-tiered A* (§4.6 tests 1, 5 and 15)
     blocked: float = 0.95  # occupancy written over environments the path must avoid
-    bog_reach: float = 3.0  # m round a reported bog that a wheeled explorer's path keeps out of (not given; bogs
-    # are 3.6-6 m across and are found at their edge)
 
 
 @dataclass
@@ -168,8 +167,10 @@ class Planner:
         start_environment = territory.environment_of(*explorer.position)
         for e in avoid - {environment, start_environment}:
             global_map[territory.slices(e)] = np.maximum(global_map[territory.slices(e)], self.params.blocked)
-        if not explorer.bog_capable:
-            self._block_bogs(global_map, job["bog_points"], explorer, job["radius"])
+        if not explorer.bog_capable:  # and out of the bogs met in its own environment (``bogs``)
+            bogs = keep_out(job["bog_points"], explorer.position, job["radius"], territory.origin,
+                            territory.resolution, global_map.shape)
+            global_map[bogs] = np.maximum(global_map[bogs], self.params.blocked)
         start, goal = territory.cell_of(*explorer.position), territory.cell_of(*territory.centre(environment))
         radius_cells = max(1, math.ceil(job["radius"] / territory.resolution))
         result = two_tier_astar(global_map, start, goal, territory.partition,
@@ -185,17 +186,3 @@ class Planner:
                   size=SMALL_MESSAGE + PATH_NODE_BYTES * len(path), to=explorer.name,
                   at=now + result.transmission_time)
         self.send("job-done", {"job_id": job["job_id"]}, to=self.manager, at=now + result.transmission_time)
-
-    def _block_bogs(self, global_map: np.ndarray, points, explorer: ExplorerState, radius: float) -> None:
-        """Cells within ``bog_reach`` of a reported bog are impassable for a wheeled explorer, even in the
-        environment it starts from, which the per-environment terrain map cannot keep it out of; never the cells
-        round the explorer itself (a robot just backed out of a bog stands nearer than that), so it can leave."""
-        territory = self.territory
-        centres = territory.origin[0] + (np.arange(territory.cells) + 0.5) * territory.resolution
-        x_cells, y_cells = np.meshgrid(centres, territory.origin[1] + (np.arange(territory.cells) + 0.5)
-                                       * territory.resolution)
-        for x, y in points:
-            reach = min(self.params.bog_reach, math.dist((x, y), explorer.position) - radius)
-            if reach > 0:
-                inside = np.hypot(x_cells - x, y_cells - y) <= reach
-                global_map[inside] = np.maximum(global_map[inside], self.params.blocked)

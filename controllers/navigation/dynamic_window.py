@@ -882,13 +882,19 @@ class HRDK(FRC):
         self.planner = planner
         self.following = following
         self.follower: PathFollower | None = None
+        self.keep_out: np.ndarray | None = None  # bool, the grid's shape: cells no plan crosses, whatever the map
+        # says (set by the user, e.g. a wheeled explorer round the bogs it met)
 
     @property
     def name(self) -> str:
         return "hrdk"
 
     def plan(self, centre: tuple[float, float]) -> None:
-        path, result = plan_on_grid(self.grid, centre, self.goal, self.planner, self.radius + self.following.clearance)
+        grid = self.grid
+        if self.keep_out is not None:
+            grid = OccupancyGrid(grid.origin, grid.resolution,
+                                 np.where(self.keep_out, grid.params.p_max, grid.probabilities), grid.params)
+        path, result = plan_on_grid(grid, centre, self.goal, self.planner, self.radius + self.following.clearance)
         self.follower = PathFollower(path, result.reached, self.grid.resolution, self.following)
 
     def waypoint(self, pose, centre, obs):

@@ -183,3 +183,60 @@ def test_inside_its_environment_an_explorer_whose_centre_is_out_of_reach_starts_
             assert t < 4 * TICK  # the first tick inside
         else:
             assert robot.params.give_up - TICK <= t <= robot.params.give_up + 1.0
+
+
+def test_a_wheeled_explorer_that_crept_into_the_bog_backs_out_until_the_ground_is_firm():
+    """The point 2 m back along its trail is still in the bog (it crept along inside before the sign held): at that
+    point, reversing slowly at high effort, it goes on straight back; it stops only where reversing takes a firm
+    ground's effort. Firm: 0.05 effort at 0.2 m/s (v_max 0.4: 0.1 per unit of speed); boggy: 0.3 at 0.08 m/s."""
+    robot = explorer(bog_capable=False)
+    t, x = drive_into_bog(robot, assigned(robot, 1))
+    target = robot.bog.first_node
+    robot.step(observe(t, (*target, 0.0), velocity=(-0.08, 0.0), effort=0.3))  # there, still in the bog
+    assert robot.state == "back-out" and not sent(robot, "reset")
+    onward = robot.bog.first_node
+    assert math.dist(onward, (target[0] - robot.params.back_out_distance, target[1])) < 1e-9  # straight back
+    v, _, behaviour = robot.step(observe(t + TICK, (target[0] - 0.5, target[1], 0.0), velocity=(-0.08, 0.0),
+                                         effort=0.3))
+    assert v < 0 and behaviour == "explorer: back out of bog"
+    robot.step(observe(t + 2 * TICK, (*onward, 0.0), velocity=(-0.2, 0.0), effort=0.05))  # firm: out
+    assert robot.state == "wait" and sent(robot, "reset") and sent(robot, "request")[-1]["bog"]
+
+
+def test_a_wheeled_explorer_backs_out_to_the_point_of_its_trail_2_m_from_where_the_bog_slowed_it():
+    """A trail that wiggled just before the bog: 2 m of it reach back only 1 m from where the bog slowed it; the
+    target is the latest trail point 2 m away as the crow flies."""
+    robot = explorer(bog_capable=False)
+    legs = [((-10.0, -4.8), (-8.0, -4.8)), ((-8.0, -4.8), (-8.0, -4.3)), ((-8.0, -4.3), (-7.5, -4.3)),
+            ((-7.5, -4.3), (-7.5, -4.8)), ((-7.5, -4.8), (-7.2, -4.8))]
+    t = 0.0
+    for (x0, y0), (x1, y1) in legs:
+        for k in range(round(math.dist((x0, y0), (x1, y1)) / 0.05)):
+            share = k * 0.05 / math.dist((x0, y0), (x1, y1))
+            robot.trail.append((t, x0 + share * (x1 - x0), y0 + share * (y1 - y0)))
+            t += TICK
+    robot.trail.append((t, -7.2, -4.8))  # slowed here
+    target = robot._before_bog(t, (-7.19, -4.8, 0.0))
+    assert math.dist(target, (-9.2, -4.8)) < 0.06
+
+
+def test_a_wheeled_explorer_s_own_plans_keep_out_of_the_bog_it_met():
+    """Backed out of a bog met going east at x, its next travel's own re-plans (HRDU on its own map) keep out of
+    the disc 3 m ahead of that spot, not of the cells round where it stands; a tracked explorer keeps out of
+    nothing."""
+    for bog_capable in (False, True):
+        robot = explorer(bog_capable=bog_capable)
+        t, x = drive_into_bog(robot, assigned(robot, 1))
+        if not bog_capable:
+            target = robot.bog.first_node
+            robot.step(observe(t, (*target, 0.0), velocity=(-0.2, 0.0)))  # out, on firm ground
+            assert robot.state == "wait"
+        robot.receive("plan", {"environment": 1, "path": np.array([robot.trail[-1][1:], robot.territory.centre(1)])},
+                      100)
+        keep_out = robot.nav.keep_out
+        if bog_capable:
+            assert keep_out is None
+            continue
+        here = robot.nav.grid.world_to_cell(*robot.trail[-1][1:])
+        ahead = robot.nav.grid.world_to_cell(x + 3.0, -4.8)
+        assert keep_out[ahead] and not keep_out[here]

@@ -81,10 +81,10 @@ def test_the_terrain_map_marks_a_reported_bog_s_environment_and_keeps_the_spot_f
     info.bog_capable, info.radii, info.rates = {"Robot4": True, "Robot2": False}, \
         {"Robot4": 0.6, "Robot2": 0.5}, {"Robot4": 1.0, "Robot2": 1.0}
     info.global_map[10:14, 10:14] = 0.1
-    info.receive("Robot2", "bog", {"environment": 0, "position": (-6.0, -6.0)}, 50.0)
-    info.receive("Robot4", "bog", {"environment": 0, "position": (-5.0, -6.0)}, 60.0)
+    info.receive("Robot2", "bog", {"environment": 0, "position": (-6.0, -6.0), "heading": 0.0}, 50.0)
+    info.receive("Robot4", "bog", {"environment": 0, "position": (-5.0, -6.0), "heading": 1.5}, 60.0)
     assert info.boggy == [True, False, False, False]
-    assert info.bog_points == [(-6.0, -6.0), (-5.0, -6.0)]
+    assert info.bog_points == [(-6.0, -6.0, 0.0), (-5.0, -6.0, 1.5)]
     assert [(e["robot"], e["environment"]) for e in info.log if e["event"] == "bog"] == [("Robot2", 0)]
     info.receive("Robot2", "reset", {"rows": [10, 11], "cols": [10, 12]}, 61.0)
     assert info.global_map[10, 10] == info.global_map[11, 12] == 0.5 and info.global_map[10, 11] == 0.1

@@ -150,3 +150,18 @@ def test_a_tracked_explorer_gets_the_last_boggy_environment_while_dry_ones_remai
         assert [p.kind for p in planner.outbox] == [expected]
         if expected == "propose":
             assert planner.outbox[0].payload["proposal"].environment == MIDDLE
+
+
+def test_a_wheeled_explorer_s_path_keeps_out_of_the_bog_ahead_of_where_it_was_met():
+    """Robot2 met a bog going east at (-7.6, -9.6) and backed out 2 m west: the bog lies ahead of that spot, so
+    its path east keeps 3 m clear of (-4.6, -9.6), 3 m ahead of it; a tracked explorer's goes straight through."""
+    start, spot, bog_centre = (-9.6, -9.6), (-7.6, -9.6, 0.0), (-4.6, -9.6)
+
+    def path(bog_capable: bool) -> np.ndarray:
+        explorer = ExplorerState("Robot2", start, 1.0, bog_capable, WEST)
+        return planned_path(Planner("Robot4", TERRITORY, manager="Robot3"),
+                            path_job(explorer, EAST) | {"bog_points": [spot]})
+
+    clearance = np.hypot(*(path(False) - bog_centre).T).min()
+    assert clearance >= 3.0 - TERRITORY.resolution
+    assert np.hypot(*(path(True) - bog_centre).T).min() < 0.5

@@ -16,6 +16,7 @@ from teamsim.controllers.navigation import dynamic_window as dw
 from teamsim.controllers.navigation.dynamic_window import (FRC, HRDK, HRDU, ODW, ODWDS, RFRC, DriveState, DynamicWindow,
                                                            DynamicWindowParams, Method, NO_CONTACT, SteeringGeometry,
                                                            _PoseTracker)
+from teamsim.controllers.navigation.occupancy_grid import OccupancyGrid
 from teamsim.controllers.skills.locomotion import next_steer
 from teamsim.models.robot import DriveLimits
 from teamsim.positioning import PoseFix
@@ -529,6 +530,23 @@ def test_hrdk_follows_its_plan_to_the_goal():
     run, controller = crossing(HRDK, ROBOT_B)
     assert run.reached and not run.collided
     assert controller.follower.reaches_goal
+
+
+def test_hrdk_plans_round_the_cells_it_is_told_to_keep_out_of():
+    """An empty known map, goal 10 m east: the plan runs straight; with a keep-out band across the way (a gap at
+    its north end) it runs through the gap, whatever the map says of those cells."""
+    grid = OccupancyGrid.known((0.0, 0.0), 0.3, np.zeros((40, 40), bool))
+    controller = HRDK(LIMITS, "diffdrive", 0.35, (11.0, 6.0), known_map=grid)
+    controller.plan((1.0, 6.0))
+    assert np.ptp(controller.follower.path[:, 1]) < 0.31
+    band = np.zeros(grid.shape, bool)
+    band[:30, 18:22] = True  # x 5.4-6.6 m, y 0-9 m: the way round is north of y = 9 m
+    controller.keep_out = band
+    controller.plan((1.0, 6.0))
+    path = controller.follower.path
+    rows, cols = grid.world_to_cell(path[:, 0], path[:, 1])
+    assert not band[rows, cols].any() and path[:, 1].max() > 9.0 and controller.follower.reaches_goal
+    assert grid.probabilities.max() == grid.params.p_min  # the map itself is untouched
 
 
 def test_hrdu_maps_replans_and_reaches_the_goal():
