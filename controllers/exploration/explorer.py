@@ -81,6 +81,7 @@ class _Bog:
     entered: float  # s, when the slow, hard driving began
     first_node: tuple[float, float]
     mapped_from: list = field(default_factory=list)  # robot positions since entering, for the cells to reset
+    beyond: bool = False  # past first_node on ground still boggy: straight back until it is firm
 
 
 class Explorer:
@@ -343,23 +344,21 @@ class Explorer:
 
     def _back_out(self, obs, pose) -> tuple[float, float, str]:
         """Reverse towards the point before the bog, steering the tail at it; reached on ground that is still
-        boggy (the robot had crept along inside the bog before the sign held), on straight back until it is firm.
-        Ends there, or stalled, or after ``back_out_limit`` s."""
+        boggy (the robot had crept along inside the bog before the sign held), on straight back until the ground is
+        firm. Ends there, or stalled, or after ``back_out_limit`` s."""
         target = self.bog.first_node
         moving = obs.velocity is not None and abs(obs.velocity[0]) >= self.params.bog_speed
         self.stalled_since = None if moving else (self.stalled_since or obs.time)
         blocked = self.stalled_since is not None and obs.time - self.stalled_since >= self.params.bog_time
-        reached = math.dist(pose[:2], target) <= self.params.waypoint_reach
-        if reached and not self._firm(obs):  # its trail ran inside the bog: on, straight back
-            distance = self.params.back_out_distance
-            target = self.bog.first_node = (pose[0] - distance * math.cos(pose[2]),
-                                            pose[1] - distance * math.sin(pose[2]))
-            reached = False
-        if reached or blocked or obs.time - self.back_out_since >= self.params.back_out_limit:
+        reached = self.bog.beyond or math.dist(pose[:2], target) <= self.params.waypoint_reach
+        if (reached and self._firm(obs)) or blocked or obs.time - self.back_out_since >= self.params.back_out_limit:
             return self._left_bog(obs.time)
+        limits = self.nav.window.limits
+        if reached:
+            self.bog.beyond = True
+            return -0.6 * limits.v_max, 0.0, "explorer: back out of bog"
         behind = math.atan2(target[1] - pose[1], target[0] - pose[0]) - (pose[2] + math.pi)
         error = math.atan2(math.sin(behind), math.cos(behind))
-        limits = self.nav.window.limits
         return -0.6 * limits.v_max, float(np.clip(1.5 * error, -limits.omega_max, limits.omega_max)), \
             "explorer: back out of bog"
 

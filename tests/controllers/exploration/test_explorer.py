@@ -186,20 +186,19 @@ def test_inside_its_environment_an_explorer_whose_centre_is_out_of_reach_starts_
 
 
 def test_a_wheeled_explorer_that_crept_into_the_bog_backs_out_until_the_ground_is_firm():
-    """The point 2 m back along its trail is still in the bog (it crept along inside before the sign held): at that
-    point, reversing slowly at high effort, it goes on straight back; it stops only where reversing takes a firm
-    ground's effort. Firm: 0.05 effort at 0.2 m/s (v_max 0.4: 0.1 per unit of speed); boggy: 0.3 at 0.08 m/s."""
+    """The point 2 m from where the bog slowed it is still in the bog (it crept along inside before the sign held):
+    there, reversing slowly at high effort, it goes on straight back; it stops at the first reading of firm ground,
+    wherever that is. Firm: 0.05 effort at 0.2 m/s (v_max 0.4: 0.1 per unit of speed); boggy: 0.3 at 0.08 m/s."""
     robot = explorer(bog_capable=False)
     t, x = drive_into_bog(robot, assigned(robot, 1))
     target = robot.bog.first_node
-    robot.step(observe(t, (*target, 0.0), velocity=(-0.08, 0.0), effort=0.3))  # there, still in the bog
+    v, omega, behaviour = robot.step(observe(t, (*target, 0.3), velocity=(-0.08, 0.0), effort=0.3))  # still boggy
     assert robot.state == "back-out" and not sent(robot, "reset")
-    onward = robot.bog.first_node
-    assert math.dist(onward, (target[0] - robot.params.back_out_distance, target[1])) < 1e-9  # straight back
-    v, _, behaviour = robot.step(observe(t + TICK, (target[0] - 0.5, target[1], 0.0), velocity=(-0.08, 0.0),
-                                         effort=0.3))
-    assert v < 0 and behaviour == "explorer: back out of bog"
-    robot.step(observe(t + 2 * TICK, (*onward, 0.0), velocity=(-0.2, 0.0), effort=0.05))  # firm: out
+    assert v < 0 and omega == 0.0 and behaviour == "explorer: back out of bog"  # straight back
+    further = (target[0] - 1.0, target[1], 0.3)  # beyond reach of the target
+    v, omega, _ = robot.step(observe(t + TICK, further, velocity=(-0.08, 0.0), effort=0.3))
+    assert v < 0 and omega == 0.0 and robot.state == "back-out"
+    robot.step(observe(t + 2 * TICK, further, velocity=(-0.2, 0.0), effort=0.05))  # firm: out, here
     assert robot.state == "wait" and sent(robot, "reset") and sent(robot, "request")[-1]["bog"]
 
 
