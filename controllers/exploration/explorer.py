@@ -11,8 +11,8 @@ cover it by the waypoints of (6.1)-(6.2), map it from its IR readings by (6.3)-(
   last update sent; every ``map_period`` s the outgoing local maps that changed go to the manager (8 KB each) and
   are reset to 0.5, so that the manager's (6.15) counts each reading once.
 - **Bogs**: high drive effort while moving, for ``bog_time`` s. Every explorer reports the bog; one that cannot cross
-  bogs also reverses along its own trail to ``back_out_distance`` short of where the bog slowed it, and on until
-  the ground is firm (the thesis: to the first node of its current path, which may lie far back), sends the
+  bogs also reverses along its own trail to ``back_out_distance`` from where the bog slowed it, and on until the
+  ground is firm (the thesis: to the first node of its current path, which may lie far back), sends the
   manager the cells it mapped from inside the bog to be reset to unexplored (0.5), and asks for a non-boggy
   environment (§6.2.2).
 - **Feedback** (§5.6.1, Table 5.30): it counts its achievements per T_m for the manager's monitor.
@@ -48,8 +48,8 @@ class ExplorerParams:
     bog_turn: float = 0.1  # ... and hardly turns (rad/s; a tracked robot's skid turn takes up to 0.8 effort) ...
     bog_time: float = 1.5  # ... for this long: a bog
     back_out_limit: float = 60.0  # s of reversing at most; it also stops when something behind stalls it
-    back_out_distance: float = 2.0  # m of its own trail to reverse beyond where the bog slowed it, and on
-    # straight back, this far at a time, until the ground is firm: ...
+    back_out_distance: float = 2.0  # m from where the bog slowed it (as the crow flies) to reverse to along its
+    # trail, then on straight back until the ground is firm: ...
     firm_speed: float = 0.1  # ... moving at this share of v_max or more, with an effort under bog_effort per unit
     # of that share (firm ground measured at most about 0.1 per unit cruising; bogs 0.3 (tracked) to 10 (diffdrive))
     waypoints: WaypointParams = WaypointParams()
