@@ -127,6 +127,8 @@ class Explorer:
             self._start_travel(payload["environment"], np.asarray(payload["path"], float))
         elif kind == "finished":
             self.state = "finished"
+        elif kind == "wake" and self.state == "finished":
+            self.state = "request"  # an environment it could take is open again
 
     # -- one control tick ---------------------------------------------------------------------------------------
     def step(self, obs) -> tuple[float, float, str]:

@@ -9,7 +9,9 @@ M1, ``GlobalInfo``:
   fraction by (6.16)-(6.19); a bog report marks its environment boggy (the terrain map, §6.1) and is kept as a
   point for the planners; a non-bog-capable explorer's bog cells are reset to 0.5;
 - faults (Fig 6.9): an explorer removed by feedback loses its jobs and its environment is reset by how well it was
-  explored (E, PE or UE) and released to the planners; a removed planner's active jobs go back to the queue.
+  explored (E, PE or UE) and released to the planners; a removed planner's active jobs go back to the queue;
+- an environment open again (released, or explored only in part) wakes the explorers that had finished for want of
+  one and could take it: they ask again (docs/decisions.md, "Finished explorers wake up").
 M2, ``FeedbackSystem``: every T_m, the workers' reports go through the ch.5 monitor and reallocation
 (``FeedbackCoordinator``); the new task scores (5.21)-(5.22) and any new roles are broadcast.
 """
@@ -28,6 +30,7 @@ from teamsim.network import Packet
 
 EXPLORER, PLANNER = "W2", "W1"  # the worker tasks of Table 5.20
 BOG_TURNS = 2  # a wheeled explorer turned back by bogs this often on its way to an environment gives it up
+RESUME_WAIT = 10.0  # s a woken explorer has to ask again before it counts as finished (it may be dead or deaf)
 
 
 @dataclass
@@ -66,6 +69,7 @@ class GlobalInfo:
         self.queue = JobQueue()
         self.busy: set[str] = set()
         self.finished: set[str] = set()
+        self.woken: dict[str, float] = {}  # explorer -> when it was woken, until it asks again
         self.outbox: list[Packet] = []
         self.log: list[dict] = []  # what the mission measures and draws: (time, event, ...)
 
@@ -81,6 +85,7 @@ class GlobalInfo:
     def _on_request(self, sender: str, payload: dict, now: float) -> None:
         if sender not in self.explorers or sender in self.finished:
             return
+        self.woken.pop(sender, None)
         record = self.records.setdefault(sender, ExplorerRecord(tuple(payload["position"]), self.bog_capable[sender],
                                                                 self.radii[sender]))
         record.position = tuple(payload["position"])
@@ -119,9 +124,12 @@ class GlobalInfo:
         status = self._integrate(environment)
         self.log.append({"t": now, "event": "explored", "robot": sender, "environment": environment,
                          "status": status, "explored": round(float(self.explored[environment]), 4)})
+        self.records[sender].environment = None
+        # The planners forget whose it was: a PE environment is on offer to the others again (§6.4.2)
+        self.send("explored", {"environment": environment, "status": status})
         if status == "PE":
             self.records[sender].excluded.add(environment)
-        self.records[sender].environment = None
+            self._wake(environment, now)
 
     def _on_assigned(self, sender: str, payload: dict, now: float) -> None:
         environment, explorer = payload["environment"], payload["explorer"]
@@ -186,6 +194,21 @@ class GlobalInfo:
         self.send("released", {"environment": environment, "status": self.status[environment]})
         self.log.append({"t": now, "event": "released", "robot": explorer, "environment": environment,
                          "status": status})
+        if self.status[environment] in ("UE", "PE"):
+            self._wake(environment, now)
+
+    def _wake(self, environment: int, now: float) -> None:
+        """The finished explorers that could take ``environment`` (not one they gave up or explored in part; a
+        boggy one only if they cross bogs) ask again; the planners and the purge decide who gets it."""
+        for explorer in sorted(self.finished):
+            record = self.records.get(explorer)
+            if explorer not in self.explorers or record is None or environment in record.excluded \
+                    or (self.boggy[environment] and not record.bog_capable):
+                continue
+            self.finished.discard(explorer)
+            self.woken[explorer] = now
+            self.send("wake", {"environment": environment}, to=explorer)
+            self.log.append({"t": now, "event": "woken", "robot": explorer, "environment": environment})
 
     def _explorer_fault(self, explorer: str, now: float) -> None:
         self.queue.drop_explorer(explorer)
@@ -197,6 +220,7 @@ class GlobalInfo:
 
     def _finish(self, explorer: str, now: float, why: str) -> None:
         self.finished.add(explorer)
+        self.woken.pop(explorer, None)
         self.send("finished", {"why": why}, to=explorer)
         self.log.append({"t": now, "event": "finished", "robot": explorer, "why": why})
 
@@ -211,6 +235,8 @@ class GlobalInfo:
     # -- one control tick ---------------------------------------------------------------------------------------
     def step(self, now: float) -> None:
         """Sort, purge and dispatch the queue (§6.4.1); integrate finished environments."""
+        for explorer in sorted(e for e, woken in self.woken.items() if now - woken >= RESUME_WAIT):
+            self._finish(explorer, now, "no answer when woken")
         scores = {e: self.task_scores.get(EXPLORER, {}).get(e, 0.0) for e in self.records}
         for explorer in self.queue.purge(self.available(), scores):
             self._finish(explorer, now, "purged: fewer environments than explorers")

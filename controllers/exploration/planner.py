@@ -86,7 +86,7 @@ class Planner:
             self.heard.append(payload["proposal"])
         elif kind == "assigned":
             self.taken[payload["environment"]] = payload["explorer"]
-        elif kind == "released":
+        elif kind in ("released", "explored"):  # no longer anyone's
             self.taken.pop(payload["environment"], None)
 
     def report(self) -> dict[str, list[float]]:

@@ -20,8 +20,8 @@ from teamsim.network import Packet
 REPORT_LEAD = 1.0  # s before each T_m boundary that a worker reports, so the report is in when the monitor runs
 MANAGER_KINDS = frozenset({"request", "map", "reset", "bog", "done", "assigned", "no-environment", "job-done",
                            "report", "scores", "roles"})
-PLANNER_KINDS = frozenset({"job", "propose", "assigned", "released"})
-EXPLORER_KINDS = frozenset({"plan", "finished"})
+PLANNER_KINDS = frozenset({"job", "propose", "assigned", "released", "explored"})
+EXPLORER_KINDS = frozenset({"plan", "finished", "wake"})
 
 
 @dataclass(frozen=True)

@@ -239,3 +239,15 @@ def test_a_wheeled_explorer_s_own_plans_keep_out_of_the_bog_it_met():
         here = robot.nav.grid.world_to_cell(*robot.trail[-1][1:])
         ahead = robot.nav.grid.world_to_cell(x + 3.0, -4.8)
         assert keep_out[ahead] and not keep_out[here]
+
+
+def test_a_finished_explorer_woken_by_the_manager_asks_again():
+    robot = explorer(bog_capable=False)
+    robot.step(observe(0.0, (-7.0, -4.8, 0.0)))
+    robot.receive("finished", {"why": "no environment for it"}, 20)
+    robot.outbox.clear()
+    robot.step(observe(TICK, (-7.0, -4.8, 0.0)))
+    assert robot.state == "finished" and not sent(robot, "request")
+    robot.receive("wake", {"environment": 3}, 20)
+    robot.step(observe(2 * TICK, (-7.0, -4.8, 0.0)))
+    assert robot.state == "wait" and sent(robot, "request")[0]["kind"] == "environment"

@@ -6,7 +6,7 @@ import os
 import subprocess
 import sys
 
-from teamsim.controllers.exploration.manager import EXPLORER, PLANNER, GlobalInfo
+from teamsim.controllers.exploration.manager import EXPLORER, PLANNER, RESUME_WAIT, GlobalInfo
 from teamsim.controllers.exploration.territory import Territory
 
 
@@ -96,7 +96,7 @@ def test_the_terrain_map_marks_a_reported_bog_s_environment_and_keeps_the_spot_f
 
 
 REMOVE_TWO = """
-from teamsim.controllers.exploration.manager import EXPLORER, PLANNER, GlobalInfo
+from teamsim.controllers.exploration.manager import EXPLORER, PLANNER, RESUME_WAIT, GlobalInfo
 from teamsim.controllers.exploration.territory import Territory
 names = ["Robot4", "Robot2", "Robot5", "Robot6", "Robot7"]
 info = GlobalInfo("Robot3", Territory(19.2, 0.3, 2), explorers=names, planners=["Robot4"],
@@ -113,3 +113,40 @@ def test_explorers_removed_together_are_handled_in_name_order_whatever_the_strin
     orders = {subprocess.run([sys.executable, "-c", REMOVE_TWO], env=os.environ | {"PYTHONHASHSEED": str(seed)},
                              capture_output=True, text=True, check=True).stdout.strip() for seed in range(4)}
     assert orders == {"Robot2 Robot5 Robot6 Robot7"}
+
+
+def woken(info: GlobalInfo) -> list[str]:
+    return [p.to for p in info.outbox if p.kind == "wake"]
+
+
+def test_an_environment_open_again_wakes_the_finished_explorers_that_could_take_it():
+    """15 % boggy world 2, [1 5]: four explorers had finished for want of environments when others gave theirs up
+    (released UE/PE) or left them explored in part; nobody took them and the run ended at 94.5 % explored. Now the
+    finished explorers that could take it ask again: not one that explored it in part or gave it up, and a wheeled
+    one only if it is not boggy. One woken that does not ask within RESUME_WAIT (dead, deaf) is finished again."""
+    explorers = ["Robot2", "Robot4", "Robot5", "Robot6"]
+    info = manager(explorers)
+    info.bog_capable = {"Robot2": False, "Robot4": True, "Robot5": False, "Robot6": False}
+    info.radii, info.rates = dict.fromkeys(explorers, 0.3), dict.fromkeys(explorers, 1.0)
+    for name in explorers:
+        info.receive(name, "request", {"kind": "environment", "position": (0.0, 0.0)}, 0.0)
+    info.receive("Robot4", "assigned", {"job_id": 1, "explorer": "Robot6", "environment": 1}, 1.0)
+    info.receive("Robot4", "assigned", {"job_id": 2, "explorer": "Robot5", "environment": 2}, 1.0)
+    info.records["Robot2"].excluded.add(1)  # Robot2 gave environment 1 up before
+    info.finished = {"Robot2", "Robot4"}
+    info.outbox.clear()
+    info.receive("Robot6", "done", {"environment": 1}, 900.0)  # nothing mapped: PE (0 % < EA_T)
+    assert info.status[1] == "PE"
+    assert woken(info) == ["Robot4"] and info.finished == {"Robot2"}
+    assert ("explored", None) in [(p.kind, p.to) for p in info.outbox]  # to the planners: no longer Robot6's
+    info.finished.add("Robot4")
+    info.boggy[2] = True
+    info.outbox.clear()
+    info.receive("Robot5", "request", {"kind": "environment", "position": (0.0, 0.0), "give_up": 2, "bog": False},
+                 950.0)
+    assert info.status[2] == "UE" and woken(info) == ["Robot4"]  # Robot2 is wheeled, 2 boggy: it stays finished
+    info.step(955.0)
+    assert "Robot4" not in info.finished
+    info.step(950.0 + RESUME_WAIT)  # Robot4 never asked
+    assert "Robot4" in info.finished
+    assert info.log[-1] == {"t": 960.0, "event": "finished", "robot": "Robot4", "why": "no answer when woken"}

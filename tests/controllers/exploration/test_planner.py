@@ -165,3 +165,24 @@ def test_a_wheeled_explorer_s_path_keeps_out_of_the_bog_ahead_of_where_it_was_me
     clearance = np.hypot(*(path(False) - bog_centre).T).min()
     assert clearance >= 3.0 - TERRITORY.resolution
     assert np.hypot(*(path(True) - bog_centre).T).min() < 0.5
+
+
+def test_an_environment_another_explorer_explored_in_part_is_offered_again():
+    """15 % world 3, [1 3]: Robot2 explored environment 7 in part (PE) and gave it back; the planner still had it
+    as Robot2's, so it was never offered to anyone and the run ended at 93.7 % explored. The manager's "explored"
+    tells the planners it is no longer anyone's: PE is on offer to every explorer but the one that left it."""
+    status = ["E"] * TERRITORY.environments
+    status[MIDDLE] = "PE"
+    east = ExplorerState("Robot5", (4.8, -4.8), 1.0, False, EAST)
+    west = ExplorerState("Robot2", (-4.8, -4.8), 1.0, False, WEST)
+    planner = Planner("Robot4", TERRITORY, manager="Robot3")
+    planner.receive("assigned", {"environment": MIDDLE, "explorer": "Robot2"}, 100)
+    planner.receive("job", assignment_job(1, east, west, status), 100)
+    planner.step(0.0)
+    assert [p.kind for p in planner.outbox] == ["no-environment"]  # still Robot2's, as far as it knows
+    planner.outbox.clear()
+    planner.receive("explored", {"environment": MIDDLE, "status": "PE"}, 100)
+    planner.receive("job", assignment_job(2, east, west, status), 100)
+    planner.step(0.1)
+    assert [p.kind for p in planner.outbox] == ["propose"]
+    assert planner.outbox[0].payload["proposal"].environment == MIDDLE
