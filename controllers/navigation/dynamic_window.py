@@ -117,7 +117,7 @@ from teamsim.controllers.navigation.path_following import PathFollower, PathFoll
 from teamsim.controllers.navigation.multi_point_turn import MultiPointTurn
 from teamsim.controllers.navigation.polar_histogram import (DirectionSensorParams, modified_target_heading,
                                                             target_heading, wrap)
-from teamsim.controllers.navigation.trap_escape import TrapEscape
+from teamsim.controllers.navigation.trap_escape import EscapeParams, TrapEscape
 from teamsim.controllers.skills.locomotion import STEER_REQUEST, next_steer
 from teamsim.models.robot import DriveLimits
 
@@ -747,7 +747,7 @@ class DynamicWindowController:
             previous = None if self.previous_direction is None else float(wrap(self.previous_direction - pose[2]))
             heading = modified_target_heading(points, heading, self.radius, self.direction, previous)
             self.previous_direction = heading + pose[2]
-        turn_first = self.escape is not None and self.escape.turn_first(bearing, obs.time)
+        turn_first = self._turn_first(bearing, obs.time)
         if turn_first and self.turn is not None:  # a tricycle turns in legs
             command = self.turn.command(self.state, points, bearing)
             self.sweep = 0.0
@@ -767,6 +767,11 @@ class DynamicWindowController:
         self.v_min = decision.v_min
         escaping = self.escape is not None and self.escape.escaping
         return self._command(decision.v, decision.omega, f"{self.name} escape" if escaping else self.name)
+
+    def _turn_first(self, bearing: float, time: float) -> bool:
+        """Whether to turn on the spot towards ``bearing`` (the way ahead, relative to the robot) before driving
+        on: a trapped FRC facing its escape plan (``TrapEscape.turn_first``)."""
+        return self.escape is not None and self.escape.turn_first(bearing, time)
 
     def _wedged(self, decision: Decision) -> bool:
         """Whether a standing tricycle is wedged: the window has nothing to do but stand, its own steering at rest
@@ -917,6 +922,14 @@ class Replanning:
     progress_period: float = 10.0  # s between progress checks (3.6)
     blocked_lookahead: int = 20  # re-plan when one of this many path nodes ahead becomes impassable
     min_interval: float = 2.0  # s: at most one re-plan this often
+    # Not in the thesis: after a progress check finds poor progress and the robot still where it was, a differential
+    # or tracked robot first turns on the spot to face its (re-planned) path, as a trapped FRC does
+    # (``TrapEscape.turn_first``, the same limits). Off by default, so the navigation study's HRDU is the thesis's;
+    # the explorers use it (docs/decisions.md, "HRDU turns to its path").
+    turn_to_path: bool = False
+    facing: float = EscapeParams.facing
+    turning: float = EscapeParams.turning
+    settle: float = 0.5  # s: the turn ends facing the path with a turn rate the drive can stop within this time
 
 
 class HRDU(HRDK):
@@ -933,8 +946,9 @@ class HRDU(HRDK):
         self.adaptation = adaptation
         self.replanning = replanning
         self.last_plan_time = -math.inf
-        self.progress_check = None  # (time, distance to goal) at the last progress check
+        self.progress_check = None  # (time, distance to goal, centre) at the last progress check
         self.replans = 0  # plans after the first
+        self.turn_started: float | None = None  # turning on the spot to face the path since (``turn_to_path``)
         # The last reading's evidence mapped into ``grid``, with its pose and time: another grid of the same frame
         # (an explorer's outgoing map) can apply it rather than compute it again.
         self.last_evidence: Evidence | None = None
@@ -955,21 +969,38 @@ class HRDU(HRDK):
         if self.follower is None:
             self.plan(centre)
             self.last_plan_time = obs.time
-            self.progress_check = (obs.time, distance)
+            self.progress_check = (obs.time, distance, centre)
             return super().waypoint(pose, centre, obs)
         if self.progress_check is None:  # following a path handed over by ``retarget``
-            self.progress_check = (obs.time, distance)
+            self.progress_check = (obs.time, distance, centre)
         replan = self.path_blocked()
         if obs.time - self.progress_check[0] >= self.replanning.progress_period:
             progress = self.progress_check[1] - distance
             self.planner = adapt_weights(self.planner, progress, self.adaptation)  # (3.6)
-            self.progress_check = (obs.time, distance)
-            replan = replan or progress < self.adaptation.min_progress
+            poor = progress < self.adaptation.min_progress
+            replan = replan or poor
+            # stuck where it was, not winding along its path: turn to face the path first
+            stuck = poor and math.dist(centre, self.progress_check[2]) < self.adaptation.min_progress
+            if stuck and self.replanning.turn_to_path and not self.window.tricycle and self.turn_started is None:
+                self.turn_started = obs.time
+            self.progress_check = (obs.time, distance, centre)
         if replan and obs.time - self.last_plan_time >= self.replanning.min_interval:
             self.plan(centre)
             self.last_plan_time = obs.time
             self.replans += 1
         return super().waypoint(pose, centre, obs)
+
+    def _turn_first(self, bearing: float, time: float) -> bool:
+        """After poor progress in place (``Replanning.turn_to_path``): until facing the path, for at most ``turning``
+        s. A slow robot with a small angular acceleration otherwise keeps a tight circle that only just clears the
+        boxes and walls beside it: reducing its turn rate would swing its arc into them (traced: a tracked explorer
+        circled for 1000 s between a box and the world's wall, its path 1 m ahead)."""
+        r = self.replanning
+        settled = abs(self.state.omega) <= self.window.limits.angular_accel_max * r.settle  # else it overshoots
+        if self.turn_started is not None and ((abs(bearing) <= r.facing and settled)
+                                              or time - self.turn_started >= r.turning):
+            self.turn_started = None
+        return self.turn_started is not None
 
     def path_blocked(self) -> bool:
         """Whether a cell now mapped impassable lies within the planning inflation of the path just ahead

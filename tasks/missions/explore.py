@@ -34,7 +34,7 @@ from teamsim.controllers.exploration.manager import EXPLORER, PLANNER, FeedbackS
 from teamsim.controllers.exploration.planner import Planner
 from teamsim.controllers.exploration.team import Addresses, TeamRobot
 from teamsim.controllers.exploration.territory import Territory
-from teamsim.controllers.navigation.dynamic_window import HRDU
+from teamsim.controllers.navigation.dynamic_window import HRDU, Replanning
 from teamsim.controllers.navigation.occupancy_grid import MappingParams
 from teamsim.models import build_robot
 from teamsim.models.robot import RobotModel, TricycleSpec
@@ -387,7 +387,7 @@ def team_controller(name: str, robot: RobotModel, info: dict) -> TeamRobot:
         if isinstance(robot.drive, TricycleSpec):
             kwargs.update(centre_offset=offset, steering=robot.drive)
         navigator = HRDU(robot.limits, robot.kind, robot.footprint_radius, (0.0, 0.0),
-                         grid=territory.unexplored_map(MAPPING), **kwargs)
+                         grid=territory.unexplored_map(MAPPING), replanning=Replanning(turn_to_path=True), **kwargs)
         return Explorer(name, territory, navigator, manager=m1, bog_capable=spec.traversability >= 1.0,
                         radius=robot.footprint_radius, params=ExplorerParams())
 

@@ -582,3 +582,31 @@ def test_every_variant_drives_without_error():
         run = kinematic_run(world, controller, ROBOT_B, duration=5.0)
         assert run.min_clearance > 0.0 and run.time == pytest.approx(5.0)
         assert controller.last_decision is not None
+
+
+def test_hrdu_turns_on_the_spot_to_face_its_path_after_poor_progress_only_when_asked():
+    """``Replanning.turn_to_path``: a robot held where it is (odometry: not moving) facing away from its goal fails
+    the progress check at 10 s; then it turns on the spot (no forward speed) until it faces the path with a turn
+    rate it can stop within ``settle`` s, or for at most ``turning`` s. Without it HRDU drives as printed."""
+    def drive(turn_to_path: bool, heading: float, seconds: float, omega: float = 0.0) -> list:
+        grid = OccupancyGrid.unexplored((-5.0, -5.0), 0.3, (34, 34))
+        controller = HRDU(LIMITS, "diffdrive", 0.35, (4.0, 0.0), grid=grid,
+                          replanning=dw.Replanning(turn_to_path=turn_to_path))
+        commands = []
+        for tick in range(round(seconds / 0.1)):
+            controller.state = DriveState(0.0, omega)
+            commands.append((tick * 0.1, controller(observation(tick * 0.1, pose=(0.0, 0.0, heading),
+                                                                velocity=(0.0, omega))), controller.turn_started))
+        return commands
+    held = drive(True, math.pi, 14.0)
+    assert all(started is None for t, _, started in held if t < 10.0)
+    turning = [command for t, command, started in held if t > 10.05]
+    assert all(started == pytest.approx(10.0) for t, _, started in held if t > 10.05)
+    assert all(command.v <= 0.0 for command in turning) and all(command.omega != 0.0 for command in turning)
+    assert any(command.v > 0.0 for t, command, _ in held if t < 10.0)  # it drove (as asked) before
+    assert all(started is None for _, _, started in drive(False, math.pi, 14.0))
+    assert drive(True, math.pi, 30.0)[-1][2] is None  # given up after ``turning`` s
+    facing = drive(True, 0.0, 10.5, omega=0.5 * LIMITS.angular_accel_max)  # no progress: held at the start
+    assert facing[-1][2] is None  # faces its path, turning slowly enough: no turn
+    spinning = drive(True, 0.0, 10.5, omega=LIMITS.omega_max)
+    assert spinning[-1][2] is not None  # faces it but would overshoot: it turns on the spot until settled
