@@ -30,7 +30,7 @@ from teamsim.network import Packet
 
 EXPLORER, PLANNER = "W2", "W1"  # the worker tasks of Table 5.20
 BOG_TURNS = 2  # a wheeled explorer turned back by bogs this often on its way to an environment gives it up
-RESUME_WAIT = 10.0  # s a woken explorer has to ask again before it counts as finished (it may be dead or deaf)
+WAKE_WAIT = 10.0  # s a woken explorer has to ask again before it counts as finished (it may be dead or deaf)
 
 
 @dataclass
@@ -235,7 +235,7 @@ class GlobalInfo:
     # -- one control tick ---------------------------------------------------------------------------------------
     def step(self, now: float) -> None:
         """Sort, purge and dispatch the queue (§6.4.1); integrate finished environments."""
-        for explorer in sorted(e for e, woken in self.woken.items() if now - woken >= RESUME_WAIT):
+        for explorer in sorted(e for e, woken in self.woken.items() if now - woken >= WAKE_WAIT):
             self._finish(explorer, now, "no answer when woken")
         scores = {e: self.task_scores.get(EXPLORER, {}).get(e, 0.0) for e in self.records}
         for explorer in self.queue.purge(self.available(), scores):

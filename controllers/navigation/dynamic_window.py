@@ -995,10 +995,11 @@ class HRDU(HRDK):
         s. A slow robot with a small angular acceleration otherwise keeps a tight circle that only just clears the
         boxes and walls beside it: reducing its turn rate would swing its arc into them (traced: a tracked explorer
         circled for 1000 s between a box and the world's wall, its path 1 m ahead)."""
+        if self.turn_started is None:
+            return False
         r = self.replanning
         settled = abs(self.state.omega) <= self.window.limits.angular_accel_max * r.settle  # else it overshoots
-        if self.turn_started is not None and ((abs(bearing) <= r.facing and settled)
-                                              or time - self.turn_started >= r.turning):
+        if (abs(bearing) <= r.facing and settled) or time - self.turn_started >= r.turning:
             self.turn_started = None
         return self.turn_started is not None
 

@@ -6,7 +6,7 @@ import os
 import subprocess
 import sys
 
-from teamsim.controllers.exploration.manager import EXPLORER, PLANNER, RESUME_WAIT, GlobalInfo
+from teamsim.controllers.exploration.manager import EXPLORER, PLANNER, WAKE_WAIT, GlobalInfo
 from teamsim.controllers.exploration.territory import Territory
 
 
@@ -96,7 +96,7 @@ def test_the_terrain_map_marks_a_reported_bog_s_environment_and_keeps_the_spot_f
 
 
 REMOVE_TWO = """
-from teamsim.controllers.exploration.manager import EXPLORER, PLANNER, RESUME_WAIT, GlobalInfo
+from teamsim.controllers.exploration.manager import EXPLORER, PLANNER, GlobalInfo
 from teamsim.controllers.exploration.territory import Territory
 names = ["Robot4", "Robot2", "Robot5", "Robot6", "Robot7"]
 info = GlobalInfo("Robot3", Territory(19.2, 0.3, 2), explorers=names, planners=["Robot4"],
@@ -123,7 +123,7 @@ def test_an_environment_open_again_wakes_the_finished_explorers_that_could_take_
     """15 % boggy world 2, [1 5]: four explorers had finished for want of environments when others gave theirs up
     (released UE/PE) or left them explored in part; nobody took them and the run ended at 94.5 % explored. Now the
     finished explorers that could take it ask again: not one that explored it in part or gave it up, and a wheeled
-    one only if it is not boggy. One woken that does not ask within RESUME_WAIT (dead, deaf) is finished again."""
+    one only if it is not boggy. One woken that does not ask within WAKE_WAIT (dead, deaf) is finished again."""
     explorers = ["Robot2", "Robot4", "Robot5", "Robot6"]
     info = manager(explorers)
     info.bog_capable = {"Robot2": False, "Robot4": True, "Robot5": False, "Robot6": False}
@@ -147,6 +147,6 @@ def test_an_environment_open_again_wakes_the_finished_explorers_that_could_take_
     assert info.status[2] == "UE" and woken(info) == ["Robot4"]  # Robot2 is wheeled, 2 boggy: it stays finished
     info.step(955.0)
     assert "Robot4" not in info.finished
-    info.step(950.0 + RESUME_WAIT)  # Robot4 never asked
+    info.step(950.0 + WAKE_WAIT)  # Robot4 never asked
     assert "Robot4" in info.finished
     assert info.log[-1] == {"t": 960.0, "event": "finished", "robot": "Robot4", "why": "no answer when woken"}
